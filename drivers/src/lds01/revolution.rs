@@ -1,0 +1,195 @@
+//! One LiDAR revolution: 360 readings in our angle convention, with time stamps.
+//!
+//! ## Angle convention
+//!
+//! Angles follow ROS REP 103: radians, **counter-clockwise** from the LiDAR's forward axis
+//! (x forward, y left, seen from above). The LDS-01 sends its readings **clockwise**: raw
+//! reading number `i = 6·k + j` (packet `k`, reading `j`) lies at `(359 − i)°`. This is the
+//! mapping of the vendor's ROS driver (`ranges[359 − i]` with `angle_min = 0`, +1° per step),
+//! which every TurtleBot3 map made with that driver relies on. So:
+//!
+//! * `readings[d]` is the reading at `d` degrees counter-clockwise, `d = 0..360`;
+//! * raw reading `i` is stored at `d = 359 − i` ([`raw_to_bin`]); raw 0 is at 359° (1° to the
+//!   right of forward), raw 89 at 270° (straight right), raw 269 at 90° (straight left),
+//!   raw 359 at 0° (straight ahead).
+//!
+//! The LiDAR frame is not the robot frame: on a TurtleBot3 Burger the LiDAR sits at
+//! x = −0.032 m, unrotated. Moving points into the robot frame is the pose code's job.
+//!
+//! ## Time stamps
+//!
+//! [`Revolution::t_start_s`] is on the sensor's own clock (`interfaces.md` §2): the start of
+//! packet slot 0, with a slot lasting `1/rpm` seconds. Raw reading `i` was taken at
+//! `t_start_s + i/360 · period_s` ([`Revolution::reading_time_s`]), so a moving robot's scan
+//! can be de-skewed. [`Revolution::host_time_us`] is the host's monotonic clock when the
+//! first packet of the revolution was decoded, when the caller supplied one.
+
+use super::packet::{PACKETS_PER_REV, READINGS_PER_REV};
+
+/// One reading in our convention.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct Reading {
+    /// Counter-clockwise angle from the LiDAR's forward axis, radians, in [0, 2π).
+    pub angle_rad: f32,
+    /// Measured range in metres (0 = no return). Kept even when `valid` is false.
+    pub range_m: f32,
+    /// Return strength as sent (not a "no return" flag: real units send intensity on zeros).
+    pub intensity: u16,
+    /// `true` if the range is non-zero and inside the configured [min, max] range window.
+    pub valid: bool,
+}
+
+/// The raw reading number `i` (0..360, clockwise) → the bin `d` (degrees counter-clockwise).
+/// Values outside 0..360 are taken modulo 360.
+#[inline]
+pub const fn raw_to_bin(i: usize) -> usize {
+    (READINGS_PER_REV - 1) - (i % READINGS_PER_REV)
+}
+
+/// The angle of bin `d` in radians.
+#[inline]
+pub fn bin_angle_rad(d: usize) -> f32 {
+    (d % READINGS_PER_REV) as f32 * (core::f32::consts::PI / 180.0)
+}
+
+/// A revolution as the assembler hands it out.
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct Revolution {
+    /// Revolution number since start (0, 1, 2, …); gaps never occur, lost ones are not numbered.
+    pub seq: u32,
+    /// Sensor-clock time of the start of packet slot 0, seconds.
+    pub t_start_s: f64,
+    /// Duration of this revolution, `60 / rpm` seconds.
+    pub period_s: f32,
+    /// Mean motor speed over the packets received, rpm.
+    pub rpm: f32,
+    /// Host clock (caller's monotonic µs) when the first packet received was decoded.
+    pub host_time_us: Option<u64>,
+    /// Packets received (60 = complete).
+    pub packets: u8,
+    /// Bit `k` set if packet `k` was received.
+    pub present: u64,
+    /// Packets received with a failed checksum (only under the `Count` policy).
+    pub bad_checksum_packets: u8,
+    /// Readings by bin: `readings[d]` is at `d` degrees counter-clockwise.
+    pub readings: [Reading; READINGS_PER_REV],
+}
+
+impl Revolution {
+    /// An empty revolution: every reading invalid at its bin's angle.
+    pub fn empty() -> Self {
+        let mut readings = [Reading::default(); READINGS_PER_REV];
+        for (d, r) in readings.iter_mut().enumerate() {
+            r.angle_rad = bin_angle_rad(d);
+        }
+        Revolution {
+            seq: 0,
+            t_start_s: 0.0,
+            period_s: 0.0,
+            rpm: 0.0,
+            host_time_us: None,
+            packets: 0,
+            present: 0,
+            bad_checksum_packets: 0,
+            readings,
+        }
+    }
+
+    /// `true` if all 60 packets arrived.
+    pub fn is_complete(&self) -> bool {
+        usize::from(self.packets) == PACKETS_PER_REV
+    }
+
+    /// Packets that did not arrive.
+    pub fn missing_packets(&self) -> u8 {
+        PACKETS_PER_REV as u8 - self.packets
+    }
+
+    /// `true` if packet `k` (0..60) arrived.
+    pub fn has_packet(&self, k: usize) -> bool {
+        k < PACKETS_PER_REV && self.present & (1 << k) != 0
+    }
+
+    /// Sensor-clock time (s) at which the reading of bin `d` was taken.
+    pub fn reading_time_s(&self, d: usize) -> f64 {
+        let i = raw_to_bin(d); // the mapping is its own inverse
+        self.t_start_s + (i as f64 / READINGS_PER_REV as f64) * f64::from(self.period_s)
+    }
+
+    /// Sensor-clock time (s) of the first ray actually received: the start of the first
+    /// packet present (the frame's time stamp). Equals `t_start_s` for a complete revolution.
+    pub fn first_ray_time_s(&self) -> f64 {
+        let first = if self.present == 0 {
+            0
+        } else {
+            self.present.trailing_zeros()
+        };
+        self.t_start_s + f64::from(first) / PACKETS_PER_REV as f64 * f64::from(self.period_s)
+    }
+
+    /// Number of valid readings.
+    pub fn valid_count(&self) -> usize {
+        self.readings.iter().filter(|r| r.valid).count()
+    }
+
+    /// Readings with a range of exactly 0 (no return) among the packets received.
+    pub fn no_return_count(&self) -> usize {
+        (0..PACKETS_PER_REV)
+            .filter(|&k| self.has_packet(k))
+            .flat_map(|k| (0..6).map(move |j| raw_to_bin(6 * k + j)))
+            .filter(|&d| self.readings[d].range_m == 0.0)
+            .count()
+    }
+
+    /// Summary statistics of the valid ranges (metres): (min, mean, max), or `None` if none.
+    pub fn range_stats(&self) -> Option<(f32, f32, f32)> {
+        let mut n = 0u32;
+        let (mut lo, mut hi, mut sum) = (f32::INFINITY, 0.0f32, 0.0f32);
+        for r in self.readings.iter().filter(|r| r.valid) {
+            n += 1;
+            lo = lo.min(r.range_m);
+            hi = hi.max(r.range_m);
+            sum += r.range_m;
+        }
+        (n > 0).then(|| (lo, sum / n as f32, hi))
+    }
+}
+
+#[cfg(test)]
+mod test {
+    use super::*;
+
+    #[test]
+    fn raw_index_mapping_follows_vendor_driver() {
+        // Vendor driver: ranges[359 - i] with angle_min 0 and +1° per step (CCW).
+        assert_eq!(raw_to_bin(0), 359);
+        assert_eq!(raw_to_bin(359), 0);
+        assert_eq!(raw_to_bin(89), 270); // right
+        assert_eq!(raw_to_bin(269), 90); // left
+        assert_eq!(raw_to_bin(179), 180); // behind
+        for i in 0..360 {
+            assert_eq!(raw_to_bin(raw_to_bin(i)), i);
+        }
+    }
+
+    #[test]
+    fn empty_has_angles() {
+        let r = Revolution::empty();
+        assert_eq!(r.valid_count(), 0);
+        assert!((r.readings[90].angle_rad - core::f32::consts::FRAC_PI_2).abs() < 1e-6);
+        assert!(r.range_stats().is_none());
+        assert_eq!(r.missing_packets(), 60);
+    }
+
+    #[test]
+    fn reading_time_runs_clockwise() {
+        let mut r = Revolution::empty();
+        r.t_start_s = 10.0;
+        r.period_s = 0.2;
+        // Raw 0 (bin 359) is first, raw 359 (bin 0) last.
+        assert!((r.reading_time_s(359) - 10.0).abs() < 1e-9);
+        assert!((r.reading_time_s(0) - (10.0 + 0.2 * 359.0 / 360.0)).abs() < 1e-6);
+    }
+}

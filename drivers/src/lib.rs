@@ -1,0 +1,31 @@
+//! # umbra drivers
+//!
+//! Wire protocols and devices for the umbra perception runtime. The protocol layers are
+//! `no_std` and allocation-free: they build for bare-metal targets (CI builds them for
+//! `thumbv7em-none-eabihf` and links a binary with no allocator). The `std` feature adds the
+//! host-side transports.
+//!
+//! | module      | owns                                                          | needs  |
+//! |-------------|---------------------------------------------------------------|--------|
+//! | [`lds01`]   | LDS-01 packets, streaming decoder, revolution assembler        | core   |
+//! | `serial`    | serial ports via `serialport`, as `embedded-io`; reopen with back-off | `std`  |
+//!
+//! ## Guarantees
+//!
+//! * No byte from a device is trusted: every parser validates before it reads, no accessor of
+//!   a checked view can panic, and every dropped byte, packet or reading is counted.
+//! * No heap in the protocol layers; every buffer is a named constant listed in
+//!   `memory-budget.md` at the repository root.
+//!
+//! ## Features
+//!
+//! * `std` (default): the `serial` module.
+//! * `defmt`: `defmt::Format` on every public data and error type.
+//!
+//! MSRV: the workspace's `rust-version`.
+#![cfg_attr(not(any(test, feature = "std")), no_std)]
+#![deny(unsafe_code, missing_docs)]
+
+pub mod lds01;
+#[cfg(feature = "std")]
+pub mod serial;

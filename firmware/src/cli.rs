@@ -1,0 +1,111 @@
+//! Command-line interface (`interfaces.md` §1).
+
+use std::path::PathBuf;
+
+use clap::{Args, Parser, Subcommand, ValueEnum};
+
+/// umbra: camera-free perception for small indoor robots.
+#[derive(Debug, Parser)]
+#[command(name = "umbra", version, about)]
+pub struct Cli {
+    /// What to do.
+    #[command(subcommand)]
+    pub command: Command,
+}
+
+/// Subcommands.
+#[derive(Debug, Subcommand)]
+pub enum Command {
+    /// Run on a robot, or on the built-in simulated robot when no hardware is named.
+    Run(RunArgs),
+    /// Run the same pipeline on a raw LiDAR capture file.
+    Replay(ReplayArgs),
+}
+
+/// LiDAR models (`--lidar-model`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum LidarModel {
+    /// Tell the model from the bytes (only the LDS-01 is supported so far).
+    Auto,
+    /// ROBOTIS LDS-01 (HLS-LFCD2).
+    Lds01,
+    /// ROBOTIS LDS-02 (LDROBOT LD08).
+    Lds02,
+    /// LDROBOT LD06.
+    Ld06,
+    /// LDROBOT LD19.
+    Ld19,
+    /// Slamtec RPLIDAR A1.
+    RplidarA1,
+    /// Slamtec RPLIDAR A2.
+    RplidarA2,
+}
+
+/// Replay pacing (`--speed`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum Speed {
+    /// As fast as possible.
+    Max,
+    /// Paced by the sensor's own clock.
+    #[value(name = "1")]
+    RealTime,
+}
+
+/// Options shared by `run` and `replay`.
+#[derive(Debug, Args)]
+pub struct Common {
+    /// Which LiDAR speaks on the port or in the capture.
+    #[arg(long, value_enum, default_value = "auto")]
+    pub lidar_model: LidarModel,
+    /// Write one JSON line per frame here (`-` = stdout).
+    #[arg(long, value_name = "PATH")]
+    pub jsonl: Option<String>,
+    /// Stop after N frames.
+    #[arg(long, value_name = "N")]
+    pub frames: Option<u64>,
+    /// Stop after S seconds (wall clock for `run`, sensor clock for `replay`).
+    #[arg(long, value_name = "S")]
+    pub seconds: Option<f64>,
+    /// TOML configuration file.
+    #[arg(long, value_name = "PATH")]
+    pub config: Option<PathBuf>,
+    /// No per-frame statistics lines.
+    #[arg(long, short)]
+    pub quiet: bool,
+}
+
+/// `umbra run`.
+#[derive(Debug, Args)]
+pub struct RunArgs {
+    /// LiDAR serial port, e.g. /dev/ttyUSB0. Without it the simulated robot runs.
+    #[arg(long, value_name = "PORT")]
+    pub lidar: Option<String>,
+    /// OpenCR serial port for wheel encoders (e.g. /dev/ttyACM0).
+    #[arg(long, value_name = "PORT")]
+    pub opencr: Option<String>,
+    /// Compass I2C bus (e.g. /dev/i2c-1).
+    #[arg(long, value_name = "BUS")]
+    pub compass: Option<String>,
+    /// Seed of the simulated room (simulated robot only).
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// Shared options.
+    #[command(flatten)]
+    pub common: Common,
+}
+
+/// `umbra replay`.
+#[derive(Debug, Args)]
+pub struct ReplayArgs {
+    /// Raw LiDAR capture (bytes as read from the serial port).
+    pub capture: PathBuf,
+    /// Odometry/compass JSON Lines on the capture's clock.
+    #[arg(long, value_name = "ODOM.jsonl")]
+    pub odom: Option<PathBuf>,
+    /// `max` runs as fast as it can; `1` paces by the sensor's own clock.
+    #[arg(long, value_enum, default_value = "max")]
+    pub speed: Speed,
+    /// Shared options.
+    #[command(flatten)]
+    pub common: Common,
+}

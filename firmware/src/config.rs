@@ -1,0 +1,182 @@
+//! The TOML configuration (`--config PATH`): every setting has a default and is validated at
+//! start-up; an error names the file and the field.
+//!
+//! ```toml
+//! [lidar]
+//! checksum = "verify"      # or "count": keep packets whose checksum fails, and count them
+//! min_range_m = 0.12       # readings outside [min, max] are marked invalid
+//! max_range_m = 3.5
+//! stale_after_ms = 500     # hand out a partial revolution after this much silence
+//!
+//! [runtime]
+//! deadline_ms = 250        # per-frame budget
+//! ```
+
+use std::fmt;
+use std::path::{Path, PathBuf};
+
+use drivers::lds01::{AssemblerConfig, ChecksumPolicy, Lds01Config};
+use serde::Deserialize;
+
+/// Checksum policy as written in the file.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Default)]
+#[serde(rename_all = "lowercase")]
+pub enum ChecksumSetting {
+    /// Drop bad packets.
+    #[default]
+    Verify,
+    /// Keep and count bad packets.
+    Count,
+}
+
+/// `[lidar]`.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct LidarSettings {
+    /// Checksum policy.
+    pub checksum: ChecksumSetting,
+    /// Shortest valid range, metres.
+    pub min_range_m: f32,
+    /// Longest valid range, metres.
+    pub max_range_m: f32,
+    /// Silence before a partial revolution is handed out, milliseconds.
+    pub stale_after_ms: u64,
+}
+
+impl Default for LidarSettings {
+    fn default() -> Self {
+        let a = AssemblerConfig::default();
+        LidarSettings {
+            checksum: ChecksumSetting::Verify,
+            min_range_m: a.min_range_m,
+            max_range_m: a.max_range_m,
+            stale_after_ms: a.stale_after_us / 1000,
+        }
+    }
+}
+
+/// `[runtime]`.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct RuntimeSettings {
+    /// Per-frame deadline, milliseconds.
+    pub deadline_ms: f64,
+}
+
+impl Default for RuntimeSettings {
+    fn default() -> Self {
+        RuntimeSettings { deadline_ms: 250.0 }
+    }
+}
+
+/// The whole configuration.
+#[derive(Debug, Clone, PartialEq, Deserialize, Default)]
+#[serde(default, deny_unknown_fields)]
+pub struct Config {
+    /// LiDAR settings.
+    pub lidar: LidarSettings,
+    /// Loop settings.
+    pub runtime: RuntimeSettings,
+}
+
+/// A configuration error, naming the file and field.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ConfigError {
+    /// The file (or `<defaults>`).
+    pub file: PathBuf,
+    /// What is wrong.
+    pub message: String,
+}
+
+impl fmt::Display for ConfigError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "configuration {}: {}", self.file.display(), self.message)
+    }
+}
+
+impl std::error::Error for ConfigError {}
+
+impl Config {
+    /// Reads and validates `path`.
+    pub fn load(path: &Path) -> Result<Config, ConfigError> {
+        let err = |message: String| ConfigError {
+            file: path.to_owned(),
+            message,
+        };
+        let text = std::fs::read_to_string(path).map_err(|e| err(format!("cannot read: {e}")))?;
+        let cfg: Config = toml::from_str(&text).map_err(|e| err(e.to_string()))?;
+        cfg.validate().map_err(err)?;
+        Ok(cfg)
+    }
+
+    /// Checks every setting; the message names the field.
+    pub fn validate(&self) -> Result<(), String> {
+        let l = &self.lidar;
+        if !(l.min_range_m.is_finite() && l.min_range_m >= 0.0) {
+            return Err(format!(
+                "lidar.min_range_m = {}: must be ≥ 0",
+                l.min_range_m
+            ));
+        }
+        if !(l.max_range_m.is_finite() && l.max_range_m > l.min_range_m && l.max_range_m <= 65.535)
+        {
+            return Err(format!(
+                "lidar.max_range_m = {}: must be above lidar.min_range_m ({}) and at most 65.535",
+                l.max_range_m, l.min_range_m
+            ));
+        }
+        if !(50..=10_000).contains(&l.stale_after_ms) {
+            return Err(format!(
+                "lidar.stale_after_ms = {}: must be within 50..=10000",
+                l.stale_after_ms
+            ));
+        }
+        let d = self.runtime.deadline_ms;
+        if !(d.is_finite() && d > 0.0 && d <= 10_000.0) {
+            return Err(format!(
+                "runtime.deadline_ms = {d}: must be within (0, 10000]"
+            ));
+        }
+        Ok(())
+    }
+
+    /// The LDS-01 driver settings.
+    pub fn lds01(&self) -> Lds01Config {
+        Lds01Config {
+            checksum: match self.lidar.checksum {
+                ChecksumSetting::Verify => ChecksumPolicy::Verify,
+                ChecksumSetting::Count => ChecksumPolicy::Count,
+            },
+            assembler: AssemblerConfig {
+                min_range_m: self.lidar.min_range_m,
+                max_range_m: self.lidar.max_range_m,
+                stale_after_us: self.lidar.stale_after_ms * 1000,
+            },
+        }
+    }
+}
+
+#[cfg(test)]
+mod test {
+    use super::*;
+
+    #[test]
+    fn defaults_are_valid() {
+        Config::default().validate().unwrap();
+        assert_eq!(Config::default().lds01(), Lds01Config::default());
+    }
+
+    #[test]
+    fn parse_and_reject() {
+        let cfg: Config =
+            toml::from_str("[lidar]\nchecksum = \"count\"\nmax_range_m = 4.2\n").unwrap();
+        assert_eq!(cfg.lidar.checksum, ChecksumSetting::Count);
+        cfg.validate().unwrap();
+        assert!(toml::from_str::<Config>("[lidar]\nchecksum = \"maybe\"\n").is_err());
+        assert!(toml::from_str::<Config>("[lidar]\nmax_rnage_m = 4.2\n").is_err());
+        let bad: Config = toml::from_str("[lidar]\nmin_range_m = 5.0\n").unwrap();
+        assert!(bad.validate().unwrap_err().contains("lidar.max_range_m"));
+        let bad: Config = toml::from_str("[runtime]\ndeadline_ms = -1.0\n").unwrap();
+        assert!(bad.validate().unwrap_err().contains("runtime.deadline_ms"));
+    }
+}

@@ -1,0 +1,18 @@
+//! # umbra firmware
+//!
+//! The `umbra` binary's parts, as a library so that the end-to-end tests can drive them.
+//!
+//! | module       | owns                                                        |
+//! |--------------|-------------------------------------------------------------|
+//! | [`cli`]      | the command line of `interfaces.md` §1                      |
+//! | [`config`]   | the TOML configuration, defaults and validation             |
+//! | [`source`]   | LiDAR byte sources: serial port, capture file, simulated robot |
+//! | [`runner`]   | the frame loop: ingest → output, limits, pacing             |
+//! | [`output`]   | the JSON output line (§3) and per-revolution statistics     |
+#![deny(unsafe_code, missing_docs)]
+
+pub mod cli;
+pub mod config;
+pub mod output;
+pub mod runner;
+pub mod source;

@@ -1,0 +1,180 @@
+//! `umbra`: see `firmware` (the library) and `interfaces.md`.
+#![deny(unsafe_code)]
+
+use std::fs::File;
+use std::io::{BufWriter, Write};
+use std::process::ExitCode;
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
+
+use clap::Parser;
+use firmware::cli::{Cli, Command, Common, LidarModel, Speed};
+use firmware::config::Config;
+use firmware::runner::{self, RunOptions, SecondsClock, Summary};
+use firmware::source::{LidarSource, Pacing};
+
+/// Exit status for bad arguments or configuration.
+const EXIT_USAGE: u8 = 2;
+/// Exit status for an unrecoverable runtime fault.
+const EXIT_FAULT: u8 = 1;
+
+fn main() -> ExitCode {
+    env_logger::Builder::from_env(env_logger::Env::default().default_filter_or("info"))
+        .format_timestamp(None)
+        .init();
+    let cli = Cli::parse();
+    match dispatch(cli) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err((code, msg)) => {
+            eprintln!("umbra: {msg}");
+            ExitCode::from(code)
+        }
+    }
+}
+
+type Failure = (u8, String);
+
+fn dispatch(cli: Cli) -> Result<(), Failure> {
+    match cli.command {
+        Command::Run(args) => {
+            let cfg = load_config(&args.common)?;
+            check_lidar_model(args.common.lidar_model)?;
+            let mut source = match &args.lidar {
+                Some(port) => LidarSource::serial(port).map_err(|m| (EXIT_FAULT, m))?,
+                None => LidarSource::sim(args.seed, args.seed),
+            };
+            println!("umbra: {}", source.describe());
+            if let Some(p) = &args.opencr {
+                log::warn!(
+                    "--opencr {p}: wheel-encoder support has not landed yet; no pose, robot assumed still"
+                );
+            } else if args.lidar.is_some() {
+                log::warn!("no --opencr named: no odometry, robot assumed still");
+            }
+            if let Some(bus) = &args.compass {
+                log::warn!("--compass {bus}: compass support has not landed yet; ignored");
+            }
+            let pacing = if source.is_simulated() {
+                Pacing::RealTime
+            } else {
+                Pacing::Max // the port paces itself
+            };
+            run_loop(&mut source, &cfg, &args.common, pacing, SecondsClock::Wall)
+        }
+        Command::Replay(args) => {
+            let cfg = load_config(&args.common)?;
+            check_lidar_model(args.common.lidar_model)?;
+            let mut source = LidarSource::capture(&args.capture).map_err(|m| (EXIT_USAGE, m))?;
+            println!("umbra: {}", source.describe());
+            if let Some(odom) = &args.odom {
+                log::warn!(
+                    "--odom {}: odometry replay has not landed yet; robot assumed still",
+                    odom.display()
+                );
+            }
+            let pacing = match args.speed {
+                Speed::Max => Pacing::Max,
+                Speed::RealTime => Pacing::RealTime,
+            };
+            run_loop(
+                &mut source,
+                &cfg,
+                &args.common,
+                pacing,
+                SecondsClock::Sensor,
+            )
+        }
+    }
+}
+
+fn load_config(common: &Common) -> Result<Config, Failure> {
+    match &common.config {
+        Some(path) => Config::load(path).map_err(|e| (EXIT_USAGE, e.to_string())),
+        None => Ok(Config::default()),
+    }
+}
+
+fn check_lidar_model(model: LidarModel) -> Result<(), Failure> {
+    match model {
+        LidarModel::Auto | LidarModel::Lds01 => Ok(()),
+        other => Err((
+            EXIT_USAGE,
+            format!(
+                "--lidar-model {other:?}: only the LDS-01 is supported so far (its issue is open)"
+            )
+            .to_lowercase(),
+        )),
+    }
+}
+
+fn run_loop(
+    source: &mut LidarSource,
+    cfg: &Config,
+    common: &Common,
+    pacing: Pacing,
+    seconds_clock: SecondsClock,
+) -> Result<(), Failure> {
+    if let Some(s) = common.seconds {
+        if !(s.is_finite() && s > 0.0) {
+            return Err((
+                EXIT_USAGE,
+                format!("--seconds {s}: must be a positive number"),
+            ));
+        }
+    }
+    let jsonl_to_stdout = common.jsonl.as_deref() == Some("-");
+    let jsonl: Option<Box<dyn Write>> = match common.jsonl.as_deref() {
+        None => None,
+        Some("-") => Some(Box::new(std::io::stdout())),
+        Some(path) => Some(Box::new(BufWriter::new(File::create(path).map_err(
+            |e| (EXIT_USAGE, format!("--jsonl {path}: cannot create: {e}")),
+        )?))),
+    };
+    let stats: Option<Box<dyn Write>> = match (common.quiet, jsonl_to_stdout) {
+        (true, _) => None,
+        (false, true) => Some(Box::new(std::io::stderr())),
+        (false, false) => Some(Box::new(std::io::stdout())),
+    };
+    let stop = Arc::new(AtomicBool::new(false));
+    let flag = stop.clone();
+    if let Err(e) = ctrlc::set_handler(move || flag.store(true, Ordering::Relaxed)) {
+        log::warn!("cannot install the Ctrl-C handler ({e}); Ctrl-C will stop without a summary");
+    }
+    let opts = RunOptions {
+        frames: common.frames,
+        seconds: common.seconds,
+        seconds_clock,
+        pacing,
+        deadline_ms: cfg.runtime.deadline_ms,
+        jsonl,
+        stats,
+        stop,
+    };
+    let summary = runner::run(source, cfg.lds01(), opts)
+        .map_err(|e| (EXIT_FAULT, format!("cannot write output: {e}")))?;
+    print_summary(&summary);
+    Ok(())
+}
+
+fn print_summary(s: &Summary) {
+    let f = &s.faults;
+    eprintln!(
+        "umbra: {} frames ({} complete) in {:.1} s sensor time, {:.1} s wall; stopped: {}",
+        s.frames, s.complete, s.sensor_seconds, s.wall_seconds, s.stop_reason
+    );
+    eprintln!(
+        "umbra: faults: bytes skipped {}, bad checksum {}, bad index {}, missing packets {}, \
+         repeated packets {}, incomplete revolutions {}, invalid readings {}, link lost {}, \
+         reopened {}, deadline misses {}",
+        f.bytes_skipped,
+        f.bad_checksum,
+        f.bad_index,
+        f.missing_packets,
+        f.repeated_packets,
+        f.incomplete_revolutions,
+        s.invalid_readings,
+        s.link.0,
+        s.link.1,
+        s.deadline_missed
+    );
+}

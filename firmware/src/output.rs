@@ -1,0 +1,239 @@
+//! The per-frame output: the JSON line of `interfaces.md` §3 and the human-readable
+//! per-revolution statistics line.
+
+use std::io::{self, Write};
+
+use drivers::lds01::{Lds01Faults, Revolution};
+use serde::Serialize;
+
+/// Pose in the map frame.
+#[derive(Debug, Clone, Copy, Serialize, Default, PartialEq)]
+pub struct PoseOut {
+    /// m
+    pub x: f64,
+    /// m
+    pub y: f64,
+    /// rad
+    pub theta: f64,
+}
+
+/// A detected object (none yet: the recognition methods have not landed).
+#[derive(Debug, Clone, Serialize, PartialEq)]
+pub struct ObjectOut {
+    /// Track id.
+    pub id: u32,
+    /// `chair`, `box`, `desk` or `door_frame`.
+    pub class: &'static str,
+    /// Map-frame centre, m.
+    pub x: f64,
+    /// Map-frame centre, m.
+    pub y: f64,
+    /// Confidence in [0, 1].
+    pub score: f64,
+    /// `A`, `B` or `AB`.
+    pub source: &'static str,
+}
+
+/// A wall segment.
+#[derive(Debug, Clone, Serialize, PartialEq)]
+pub struct WallOut {
+    /// m
+    pub x0: f64,
+    /// m
+    pub y0: f64,
+    /// m
+    pub x1: f64,
+    /// m
+    pub y1: f64,
+}
+
+/// A door.
+#[derive(Debug, Clone, Serialize, PartialEq)]
+pub struct DoorOut {
+    /// m
+    pub x: f64,
+    /// m
+    pub y: f64,
+    /// m
+    pub width: f64,
+    /// [0, 1]
+    pub score: f64,
+}
+
+/// Stage times, milliseconds. Stages that do not exist yet are absent, not zero.
+#[derive(Debug, Clone, Copy, Serialize, Default, PartialEq)]
+pub struct TimingOut {
+    /// Reading and decoding the revolution's bytes.
+    pub ingest: f64,
+    /// Whole frame.
+    pub total: f64,
+}
+
+/// Cumulative fault counters (`interfaces.md` names first, extra keys after).
+#[derive(Debug, Clone, Copy, Serialize, Default, PartialEq, Eq)]
+pub struct FaultsOut {
+    /// Bytes not part of any packet passed on.
+    pub lidar_bytes_skipped: u64,
+    /// Packets whose checksum failed.
+    pub lidar_bad_checksum: u64,
+    /// Packets missing from revolutions.
+    pub lidar_missing_packets: u64,
+    /// Wheel-encoder errors (no encoder source yet: always 0).
+    pub encoder_errors: u64,
+    /// Compass readings rejected (no compass source yet: always 0).
+    pub compass_rejected: u64,
+    /// Sync bytes followed by a bad index.
+    pub lidar_bad_index: u64,
+    /// Packets received twice.
+    pub lidar_repeated_packets: u64,
+    /// Revolutions with packets missing.
+    pub lidar_incomplete_revolutions: u64,
+    /// Readings dropped as invalid (no return, or outside the range window), in received
+    /// packets.
+    pub lidar_invalid_readings: u64,
+    /// Link losses (read errors, hang-ups).
+    pub lidar_link_lost: u64,
+    /// Link reopens.
+    pub lidar_link_reopened: u64,
+}
+
+impl FaultsOut {
+    /// From the LiDAR stream's counters and the link's.
+    pub fn new(f: &Lds01Faults, invalid_readings: u64, link: (u64, u64)) -> Self {
+        FaultsOut {
+            lidar_bytes_skipped: f.bytes_skipped,
+            lidar_bad_checksum: f.bad_checksum,
+            lidar_missing_packets: f.missing_packets,
+            encoder_errors: 0,
+            compass_rejected: 0,
+            lidar_bad_index: f.bad_index,
+            lidar_repeated_packets: f.repeated_packets,
+            lidar_incomplete_revolutions: f.incomplete_revolutions,
+            lidar_invalid_readings: invalid_readings,
+            lidar_link_lost: link.0,
+            lidar_link_reopened: link.1,
+        }
+    }
+}
+
+/// What this frame's LiDAR revolution looked like (an extra field).
+#[derive(Debug, Clone, Copy, Serialize, Default, PartialEq)]
+pub struct LidarOut {
+    /// Mean motor speed, rpm.
+    pub rpm: f64,
+    /// Packets received of 60.
+    pub packets: u8,
+    /// Valid readings of 360.
+    pub valid: u32,
+}
+
+/// One output line (`interfaces.md` §3).
+#[derive(Debug, Clone, Serialize, PartialEq)]
+pub struct OutputLine {
+    /// Frame number since start.
+    pub frame: u64,
+    /// Sensor-clock time of the frame's first ray, s.
+    pub t: f64,
+    /// Robot pose in the map frame.
+    pub pose: PoseOut,
+    /// Recognised objects.
+    pub objects: Vec<ObjectOut>,
+    /// Wall segments.
+    pub walls: Vec<WallOut>,
+    /// Doors.
+    pub doors: Vec<DoorOut>,
+    /// Stage times.
+    pub timing_ms: TimingOut,
+    /// The per-frame budget.
+    pub deadline_ms: f64,
+    /// `true` if the frame took longer than its budget.
+    pub deadline_missed: bool,
+    /// `true` if work was shed to stay within the budget.
+    pub degraded: bool,
+    /// Power draw, W (`null`: no power source yet).
+    pub power_w: Option<f64>,
+    /// Cumulative fault counters.
+    pub faults: FaultsOut,
+    /// The revolution behind this frame.
+    pub lidar: LidarOut,
+}
+
+impl OutputLine {
+    /// Writes the line and a newline.
+    pub fn write_to(&self, w: &mut impl Write) -> io::Result<()> {
+        serde_json::to_writer(&mut *w, self)?;
+        w.write_all(b"\n")
+    }
+}
+
+/// The human-readable per-revolution line.
+pub fn stats_line(frame: u64, rev: &Revolution) -> String {
+    let ranges = match rev.range_stats() {
+        Some((lo, mean, hi)) => format!("range {lo:.2}–{hi:.2} m (mean {mean:.2})"),
+        None => "no valid range".to_owned(),
+    };
+    format!(
+        "frame {frame:>6}  t {:>9.3} s  {:>5.1} rpm  packets {:>2}/60  valid {:>3}/360  no-return {:>3}  {ranges}",
+        rev.first_ray_time_s(),
+        rev.rpm,
+        rev.packets,
+        rev.valid_count(),
+        rev.no_return_count(),
+    )
+}
+
+#[cfg(test)]
+mod test {
+    use super::*;
+
+    #[test]
+    fn line_has_contract_fields() {
+        let line = OutputLine {
+            frame: 3,
+            t: 0.6,
+            pose: PoseOut::default(),
+            objects: vec![],
+            walls: vec![],
+            doors: vec![],
+            timing_ms: TimingOut {
+                ingest: 0.1,
+                total: 0.2,
+            },
+            deadline_ms: 250.0,
+            deadline_missed: false,
+            degraded: false,
+            power_w: None,
+            faults: FaultsOut::default(),
+            lidar: LidarOut::default(),
+        };
+        let mut buf = Vec::new();
+        line.write_to(&mut buf).unwrap();
+        let v: serde_json::Value = serde_json::from_slice(&buf).unwrap();
+        for key in [
+            "frame",
+            "t",
+            "pose",
+            "objects",
+            "walls",
+            "doors",
+            "timing_ms",
+            "deadline_ms",
+            "deadline_missed",
+            "degraded",
+            "power_w",
+            "faults",
+        ] {
+            assert!(v.get(key).is_some(), "missing {key}");
+        }
+        for key in [
+            "lidar_bytes_skipped",
+            "lidar_bad_checksum",
+            "lidar_missing_packets",
+            "encoder_errors",
+            "compass_rejected",
+        ] {
+            assert!(v["faults"].get(key).is_some(), "missing faults.{key}");
+        }
+        assert!(buf.ends_with(b"}\n"));
+    }
+}

@@ -1,0 +1,236 @@
+//! The frame loop as it stands: ingest → output. One frame per LiDAR revolution.
+//!
+//! Bytes are read into one fixed buffer ([`READ_CHUNK`] bytes), fed to the LDS-01 stream,
+//! and each finished revolution becomes a frame: a statistics line, a JSON line, or both.
+//! Pose, Method A and Method B join this loop as their issues land.
+
+use std::io::Write;
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::{Duration, Instant};
+
+use drivers::lds01::{Lds01Config, Lds01Faults, Lds01Stream, Revolution};
+
+use crate::output::{FaultsOut, LidarOut, OutputLine, PoseOut, TimingOut, stats_line};
+use crate::source::{LidarSource, Pacing, SourceRead};
+
+/// Bytes read from the source at a time (~0.2 revolution; a capture is read in these too).
+pub const READ_CHUNK: usize = 512;
+
+/// When the `--seconds` limit is measured.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum SecondsClock {
+    /// Wall-clock time since start (live sources).
+    Wall,
+    /// Sensor-clock time (replay).
+    Sensor,
+}
+
+/// Loop options.
+pub struct RunOptions {
+    /// Stop after this many frames.
+    pub frames: Option<u64>,
+    /// Stop after this many seconds.
+    pub seconds: Option<f64>,
+    /// Which clock `seconds` uses.
+    pub seconds_clock: SecondsClock,
+    /// Pacing.
+    pub pacing: Pacing,
+    /// Per-frame budget, ms.
+    pub deadline_ms: f64,
+    /// JSON lines go here.
+    pub jsonl: Option<Box<dyn Write>>,
+    /// Statistics lines go here (`None`: quiet).
+    pub stats: Option<Box<dyn Write>>,
+    /// Set from outside (Ctrl-C) to stop cleanly.
+    pub stop: Arc<AtomicBool>,
+}
+
+/// What a run did.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Summary {
+    /// Frames (revolutions) handed out.
+    pub frames: u64,
+    /// Complete revolutions among them.
+    pub complete: u64,
+    /// Frames over budget.
+    pub deadline_missed: u64,
+    /// Bytes read.
+    pub bytes: u64,
+    /// Final fault counters.
+    pub faults: Lds01Faults,
+    /// Readings marked invalid.
+    pub invalid_readings: u64,
+    /// Link losses and reopens.
+    pub link: (u64, u64),
+    /// Sensor time covered, s.
+    pub sensor_seconds: f64,
+    /// Wall time, s.
+    pub wall_seconds: f64,
+    /// Why the run stopped.
+    pub stop_reason: &'static str,
+}
+
+/// Runs the loop until a limit, the end of the source, or the stop flag.
+pub fn run(
+    source: &mut LidarSource,
+    cfg: Lds01Config,
+    mut opts: RunOptions,
+) -> Result<Summary, std::io::Error> {
+    let mut stream = Lds01Stream::new(cfg);
+    let mut buf = [0u8; READ_CHUNK];
+    let start = Instant::now();
+    let mut summary = Summary::default();
+    let mut ingest = Duration::ZERO;
+
+    let reason = 'outer: loop {
+        if opts.stop.load(Ordering::Relaxed) {
+            break 'outer "stopped by signal";
+        }
+        if let Some(s) = opts.seconds {
+            let elapsed = match opts.seconds_clock {
+                SecondsClock::Wall => start.elapsed().as_secs_f64(),
+                SecondsClock::Sensor => stream.sensor_time_s(),
+            };
+            if elapsed >= s {
+                break 'outer "time limit";
+            }
+        }
+        let t0 = Instant::now();
+        let host_us = || start.elapsed().as_micros() as u64;
+        let n = match source.read(&mut buf) {
+            SourceRead::Data(n) => n,
+            SourceRead::Idle => {
+                let now = host_us();
+                if stream.poll(now, |_| {}) {
+                    ingest += t0.elapsed();
+                    if emit_frame_ref(&stream, source, &mut opts, &mut summary, &mut ingest)? {
+                        break 'outer "frame limit";
+                    }
+                }
+                continue;
+            }
+            SourceRead::End => {
+                if stream.finish(|_| {}) {
+                    emit_frame_ref(&stream, source, &mut opts, &mut summary, &mut ingest)?;
+                }
+                break 'outer "end of input";
+            }
+            SourceRead::Lost(msg) => {
+                log::warn!("{msg}; reopening with back-off");
+                stream.link_reset();
+                continue;
+            }
+            SourceRead::Reopened => {
+                log::info!("LiDAR link reopened");
+                continue;
+            }
+        };
+        summary.bytes += n as u64;
+        let mut input = &buf[..n.min(READ_CHUNK)];
+        let now = host_us();
+        loop {
+            let t_feed = Instant::now();
+            let done = stream.next_revolution(&mut input, Some(now));
+            ingest += t_feed.elapsed();
+            if !done {
+                break;
+            }
+            let limit = emit_frame_ref(&stream, source, &mut opts, &mut summary, &mut ingest)?;
+            if limit {
+                break 'outer "frame limit";
+            }
+        }
+        if opts.pacing == Pacing::RealTime {
+            let ahead = stream.sensor_time_s() - start.elapsed().as_secs_f64();
+            if ahead > 0.0 {
+                std::thread::sleep(Duration::from_secs_f64(ahead.min(1.0)));
+            }
+        }
+    };
+    summary.faults = stream.faults();
+    summary.link = source.link_counts();
+    summary.sensor_seconds = stream.sensor_time_s();
+    summary.wall_seconds = start.elapsed().as_secs_f64();
+    summary.stop_reason = reason;
+    if let Some(w) = opts.jsonl.as_mut() {
+        w.flush()?;
+    }
+    if let Some(w) = opts.stats.as_mut() {
+        w.flush()?;
+    }
+    Ok(summary)
+}
+
+fn emit_frame_ref(
+    stream: &Lds01Stream,
+    source: &LidarSource,
+    opts: &mut RunOptions,
+    summary: &mut Summary,
+    ingest: &mut Duration,
+) -> std::io::Result<bool> {
+    match stream.last_revolution() {
+        Some(rev) => emit_frame(rev, stream, source, opts, summary, ingest),
+        None => Ok(false),
+    }
+}
+
+/// Writes one frame; returns `true` when the frame limit is reached.
+fn emit_frame(
+    rev: &Revolution,
+    stream: &Lds01Stream,
+    source: &LidarSource,
+    opts: &mut RunOptions,
+    summary: &mut Summary,
+    ingest: &mut Duration,
+) -> std::io::Result<bool> {
+    let t_frame = Instant::now();
+    let frame = summary.frames;
+    let valid = rev.valid_count() as u32;
+    summary.frames += 1;
+    if rev.is_complete() {
+        summary.complete += 1;
+    }
+    summary.invalid_readings += u64::from(rev.packets) * 6 - u64::from(valid);
+
+    if let Some(w) = opts.stats.as_mut() {
+        writeln!(w, "{}", stats_line(frame, rev))?;
+    }
+    let ingest_ms = ingest.as_secs_f64() * 1e3;
+    let total_ms = ingest_ms + t_frame.elapsed().as_secs_f64() * 1e3;
+    let missed = total_ms > opts.deadline_ms;
+    if missed {
+        summary.deadline_missed += 1;
+    }
+    if let Some(w) = opts.jsonl.as_mut() {
+        let line = OutputLine {
+            frame,
+            t: rev.first_ray_time_s().max(0.0),
+            pose: PoseOut::default(),
+            objects: Vec::new(),
+            walls: Vec::new(),
+            doors: Vec::new(),
+            timing_ms: TimingOut {
+                ingest: ingest_ms,
+                total: total_ms,
+            },
+            deadline_ms: opts.deadline_ms,
+            deadline_missed: missed,
+            degraded: false,
+            power_w: None,
+            faults: FaultsOut::new(
+                &stream.faults(),
+                summary.invalid_readings,
+                source.link_counts(),
+            ),
+            lidar: LidarOut {
+                rpm: f64::from(rev.rpm),
+                packets: rev.packets,
+                valid,
+            },
+        };
+        line.write_to(w)?;
+    }
+    *ingest = Duration::ZERO;
+    Ok(opts.frames.is_some_and(|n| summary.frames >= n))
+}

@@ -1,0 +1,148 @@
+//! Where LiDAR bytes come from: a serial port, a raw capture file, or the simulated robot.
+//! All three hand bytes to the same decoder.
+
+use std::fs::File;
+use std::path::{Path, PathBuf};
+
+use drivers::lds01::PACKET_LEN;
+use drivers::serial::{LinkRead, SerialConfig, SerialLink};
+use embedded_io::Read as _;
+use embedded_io_adapters::std::FromStd;
+use sim::lds01::{Lds01Sim, Lds01SimConfig};
+use sim::world::World;
+
+/// What one read gave.
+#[derive(Debug)]
+pub enum SourceRead {
+    /// Bytes in the buffer.
+    Data(usize),
+    /// Nothing yet.
+    Idle,
+    /// The source ended (end of a capture file).
+    End,
+    /// The link was lost (it will be reopened); the message names the device.
+    Lost(String),
+    /// The link came back.
+    Reopened,
+}
+
+/// Whether the loop paces itself by the sensor clock.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Pacing {
+    /// As fast as possible.
+    Max,
+    /// Wall time follows the sensor clock.
+    RealTime,
+}
+
+/// A LiDAR byte source.
+pub enum LidarSource {
+    /// A serial port that reopens itself.
+    Serial(SerialLink),
+    /// A raw capture file read through `embedded-io`.
+    Capture {
+        /// The file's path, for messages.
+        path: PathBuf,
+        /// The file.
+        file: FromStd<File>,
+    },
+    /// The built-in simulated robot.
+    Sim {
+        /// The simulator.
+        sim: Box<Lds01Sim>,
+        /// Room seed, for messages.
+        room_seed: u64,
+    },
+}
+
+/// Packets the simulated source produces per read (a tenth of a revolution).
+pub const SIM_PACKETS_PER_READ: usize = 6;
+
+impl LidarSource {
+    /// Opens a serial port for the LDS-01.
+    pub fn serial(path: &str) -> Result<Self, String> {
+        SerialLink::open(path, SerialConfig::lds01())
+            .map(LidarSource::Serial)
+            .map_err(|e| e.to_string())
+    }
+
+    /// Opens a raw capture file.
+    pub fn capture(path: &Path) -> Result<Self, String> {
+        let file =
+            File::open(path).map_err(|e| format!("cannot open capture {}: {e}", path.display()))?;
+        Ok(LidarSource::Capture {
+            path: path.to_owned(),
+            file: FromStd::new(file),
+        })
+    }
+
+    /// The simulated robot in a seeded random room.
+    pub fn sim(room_seed: u64, noise_seed: u64) -> Self {
+        LidarSource::Sim {
+            sim: Box::new(Lds01Sim::new(
+                World::random_room(room_seed),
+                Lds01SimConfig::default(),
+                noise_seed,
+            )),
+            room_seed,
+        }
+    }
+
+    /// One line saying what this source is.
+    pub fn describe(&self) -> String {
+        match self {
+            LidarSource::Serial(link) => format!("LDS-01 on serial port {}", link.path()),
+            LidarSource::Capture { path, .. } => format!("raw LDS-01 capture {}", path.display()),
+            LidarSource::Sim { sim, room_seed } => format!(
+                "no hardware named: running on the built-in simulated robot (LDS-01, room seed {room_seed}, {:.1} × {:.1} m room)",
+                sim.world().size.0,
+                sim.world().size.1
+            ),
+        }
+    }
+
+    /// Default pacing: live sources are paced by the device itself (serial) or by the sensor
+    /// clock (the simulator, so it behaves like the robot); files run as fast as possible.
+    pub fn is_simulated(&self) -> bool {
+        matches!(self, LidarSource::Sim { .. })
+    }
+
+    /// Reads what is available into `buf`.
+    pub fn read(&mut self, buf: &mut [u8]) -> SourceRead {
+        match self {
+            LidarSource::Serial(link) => match link.read(buf) {
+                LinkRead::Data(n) => SourceRead::Data(n),
+                LinkRead::Idle => SourceRead::Idle,
+                LinkRead::Lost(e) => SourceRead::Lost(e.to_string()),
+                LinkRead::Reopened => SourceRead::Reopened,
+            },
+            LidarSource::Capture { path, file } => match file.read(buf) {
+                Ok(0) => SourceRead::End,
+                Ok(n) => SourceRead::Data(n),
+                Err(e) if e.kind() == std::io::ErrorKind::Interrupted => SourceRead::Idle,
+                Err(e) => SourceRead::Lost(format!("capture {}: read error: {e}", path.display())),
+            },
+            LidarSource::Sim { sim, .. } => {
+                let mut n = 0;
+                for chunk in buf.chunks_exact_mut(PACKET_LEN).take(SIM_PACKETS_PER_READ) {
+                    let mut packet = [0u8; PACKET_LEN];
+                    sim.emit_packet(&mut packet);
+                    chunk.copy_from_slice(&packet);
+                    n += PACKET_LEN;
+                }
+                SourceRead::Data(n)
+            }
+        }
+    }
+
+    /// Link counters of a serial source: (errors + EOFs, reopens).
+    pub fn link_counts(&self) -> (u64, u64) {
+        match self {
+            LidarSource::Serial(link) => {
+                let s = link.stats();
+                (s.read_errors + s.eofs, s.reopens)
+            }
+            _ => (0, 0),
+        }
+    }
+}

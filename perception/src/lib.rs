@@ -1,0 +1,18 @@
+//! # umbra perception
+//!
+//! The `no_std`, allocation-free core of umbra's perception. It builds for bare-metal targets
+//! (CI checks `thumbv7em-none-eabihf` with no allocator) and never depends on the binary, the
+//! simulator or tract.
+//!
+//! | module         | owns                                                         |
+//! |----------------|--------------------------------------------------------------|
+//! | [`geometry`]   | 2D points and rigid poses in REP 103 (x forward, y left, CCW) |
+//! | [`class`]      | the object classes both methods report, with their wire names |
+//!
+//! The global point cloud, DBSCAN, walls and doors, features, the scan raster and YOLO decoding
+//! arrive with their issues; each capacity is a named constant listed in `memory-budget.md`.
+#![cfg_attr(not(any(test, feature = "std")), no_std)]
+#![deny(unsafe_code, missing_docs)]
+
+pub mod class;
+pub mod geometry;
