@@ -16,6 +16,8 @@ pub struct Corruption {
     pub drop: f64,
     /// Probability that a burst of 1–64 random bytes precedes a packet.
     pub burst: f64,
+    /// At most this many bits flipped per packet (`u32::MAX`: independent flips, no cap).
+    pub max_flips_per_packet: u32,
 }
 
 impl Corruption {
@@ -25,6 +27,7 @@ impl Corruption {
         insert: 0.0,
         drop: 0.0,
         burst: 0.0,
+        max_flips_per_packet: u32::MAX,
     };
 
     /// The acceptance mix of the foundation issue: bit flips at 1e-3 per bit plus inserted and
@@ -34,6 +37,7 @@ impl Corruption {
         insert: 1e-4,
         drop: 1e-4,
         burst: 0.01,
+        max_flips_per_packet: u32::MAX,
     };
 }
 
@@ -68,6 +72,7 @@ pub fn corrupt<'a>(
             out.inserted += n;
         }
         let mut clean = true;
+        let mut flips = 0u32;
         for &byte in packet {
             if c.insert > 0.0 && rng.random_bool(c.insert) {
                 out.bytes.push(rng.random());
@@ -82,7 +87,8 @@ pub fn corrupt<'a>(
             let mut b = byte;
             if c.bit_flip > 0.0 {
                 for bit in 0..8 {
-                    if rng.random_bool(c.bit_flip) {
+                    if rng.random_bool(c.bit_flip) && flips < c.max_flips_per_packet {
+                        flips += 1;
                         b ^= 1 << bit;
                         out.flips += 1;
                         clean = false;
