@@ -102,9 +102,15 @@ fn detectable_errors_never_accepted_under_verify() {
         ..Corruption::ISSUE_MIX
     };
     let f = run(1000, mix, 42, ChecksumPolicy::Verify);
-    report("1e-3 bit flips (≤ 1 per packet) + inserts + drops + bursts, verify", &f);
+    report(
+        "1e-3 bit flips (≤ 1 per packet) + inserts + drops + bursts, verify",
+        &f,
+    );
     assert!(f.untouched_recovered as f64 >= 0.99 * f.untouched as f64);
-    assert_eq!(f.corrupt_accepted, 0, "corrupt packets accepted under verify");
+    assert_eq!(
+        f.corrupt_accepted, 0,
+        "corrupt packets accepted under verify"
+    );
 }
 
 #[test]
