@@ -1,0 +1,91 @@
+//! Keeps `memory-budget.md` true: every fixed buffer in the code has a row whose capacity,
+//! element size and byte total match the constants and types, and every row names a buffer
+//! the code still has.
+
+use std::collections::BTreeMap;
+use std::mem::size_of;
+
+use drivers::lds01::assembler::ASSEMBLER_REVOLUTIONS;
+use drivers::lds01::decoder::DECODER_BUFFER_LEN;
+use drivers::lds01::{Lds01Stream, READINGS_PER_REV, Reading, Revolution};
+use firmware::runner::READ_CHUNK;
+
+/// (constant path as written in the table, capacity, element bytes), read from the code.
+fn buffers_in_code() -> Vec<(&'static str, usize, usize)> {
+    vec![
+        (
+            "drivers::lds01::decoder::DECODER_BUFFER_LEN",
+            DECODER_BUFFER_LEN,
+            1,
+        ),
+        (
+            "drivers::lds01::assembler::ASSEMBLER_REVOLUTIONS",
+            ASSEMBLER_REVOLUTIONS,
+            size_of::<Revolution>(),
+        ),
+        (
+            "drivers::lds01::READINGS_PER_REV",
+            READINGS_PER_REV,
+            size_of::<Reading>(),
+        ),
+        (
+            "size_of::<drivers::lds01::Lds01Stream>()",
+            1,
+            size_of::<Lds01Stream>(),
+        ),
+        ("firmware::runner::READ_CHUNK", READ_CHUNK, 1),
+    ]
+}
+
+/// Rows of the table: constant → (capacity, element bytes, bytes).
+fn rows_in_doc() -> BTreeMap<String, (usize, usize, usize)> {
+    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../memory-budget.md");
+    let text = std::fs::read_to_string(path).expect("memory-budget.md at the repository root");
+    let mut rows = BTreeMap::new();
+    for line in text.lines().filter(|l| l.starts_with('|')) {
+        let cells: Vec<&str> = line.trim_matches('|').split('|').map(str::trim).collect();
+        if cells.len() < 6 || !cells[1].starts_with('`') {
+            continue; // header, separator, or a row without a constant
+        }
+        let num = |s: &str| s.replace([',', ' '], "").parse::<usize>();
+        let (Ok(cap), Ok(elem), Ok(bytes)) = (num(cells[2]), num(cells[3]), num(cells[4])) else {
+            panic!("memory-budget.md: unreadable numbers in row: {line}");
+        };
+        rows.insert(cells[1].trim_matches('`').to_owned(), (cap, elem, bytes));
+    }
+    rows
+}
+
+#[test]
+fn memory_budget_matches_code() {
+    let doc = rows_in_doc();
+    let code = buffers_in_code();
+    for (name, cap, elem) in &code {
+        let Some(&(dcap, delem, dbytes)) = doc.get(*name) else {
+            panic!("memory-budget.md has no row for `{name}` (capacity {cap}, element {elem} B)");
+        };
+        assert_eq!(
+            (dcap, delem),
+            (*cap, *elem),
+            "row `{name}`: capacity/element size"
+        );
+        assert_eq!(
+            dbytes,
+            cap * elem,
+            "row `{name}`: bytes ≠ capacity × element"
+        );
+    }
+    for name in doc.keys() {
+        assert!(
+            code.iter().any(|(n, ..)| n == name),
+            "memory-budget.md row `{name}` names no buffer the test knows; add it to buffers_in_code()"
+        );
+    }
+}
+
+#[test]
+fn print_sizes() {
+    for (name, cap, elem) in buffers_in_code() {
+        println!("{name}: {cap} × {elem} B = {} B", cap * elem);
+    }
+}
