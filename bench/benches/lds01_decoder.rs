@@ -20,7 +20,7 @@ fn decoders(c: &mut Criterion) {
             let mut revs = 0usize;
             for chunk in bytes.chunks(CHUNK) {
                 revs += s.feed(black_box(chunk), None, |r| {
-                    black_box(r.readings[0].range_m);
+                    black_box(r);
                 });
             }
             black_box(revs)
@@ -32,7 +32,7 @@ fn decoders(c: &mut Criterion) {
             let mut buff = [0u8; 2520];
             let mut revs = 0usize;
             while let Some(scan) = bench::vendor_poll(&mut cursor, &mut buff) {
-                black_box(scan.ranges[0]);
+                black_box(&scan);
                 revs += 1;
             }
             black_box(revs)

@@ -114,13 +114,13 @@ fn run_loop(
     pacing: Pacing,
     seconds_clock: SecondsClock,
 ) -> Result<(), Failure> {
-    if let Some(s) = common.seconds {
-        if !(s.is_finite() && s > 0.0) {
-            return Err((
-                EXIT_USAGE,
-                format!("--seconds {s}: must be a positive number"),
-            ));
-        }
+    if let Some(s) = common.seconds
+        && !(s.is_finite() && s > 0.0)
+    {
+        return Err((
+            EXIT_USAGE,
+            format!("--seconds {s}: must be a positive number"),
+        ));
     }
     let jsonl_to_stdout = common.jsonl.as_deref() == Some("-");
     let jsonl: Option<Box<dyn Write>> = match common.jsonl.as_deref() {

@@ -48,10 +48,10 @@ fn expect_byte(master: &mut TTYPort, byte: u8, timeout: Duration) -> bool {
     let end = Instant::now() + timeout;
     let mut buf = [0u8; 64];
     while Instant::now() < end {
-        if let Ok(n) = master.read(&mut buf) {
-            if buf[..n].contains(&byte) {
-                return true;
-            }
+        if let Ok(n) = master.read(&mut buf)
+            && buf[..n].contains(&byte)
+        {
+            return true;
         }
     }
     false

@@ -26,7 +26,7 @@
 
 use super::decoder::Decoded;
 use super::packet::{PACKETS_PER_REV, READINGS_PER_PACKET, Repr};
-use super::revolution::{Reading, Revolution, bin_angle_rad, raw_to_bin};
+use super::revolution::{EMPTY_READINGS, Reading, Revolution, bin_angle_rad, raw_to_bin};
 
 /// Revolution buffers the assembler holds: the one being filled and the last finished one.
 pub const ASSEMBLER_REVOLUTIONS: usize = 2;
@@ -80,6 +80,8 @@ struct Clock {
     t_last: f64,
     last_index: u8,
     rpm: f32,
+    /// `1 / rpm`: one packet slot, seconds (recomputed only when the speed changes).
+    slot_s: f64,
     started: bool,
 }
 
@@ -116,6 +118,7 @@ impl Assembler {
                 t_last: 0.0,
                 last_index: 0,
                 rpm: NOMINAL_RPM,
+                slot_s: 1.0 / NOMINAL_RPM as f64,
                 started: false,
             },
             stats: AssemblerStats::default(),
@@ -140,7 +143,7 @@ impl Assembler {
     /// Sensor-clock time of the end of the last packet slot seen, seconds.
     pub fn sensor_time_s(&self) -> f64 {
         if self.clock.started {
-            self.clock.t_last + 1.0 / f64::from(self.clock.rpm)
+            self.clock.t_last + self.clock.slot_s
         } else {
             0.0
         }
@@ -184,7 +187,7 @@ impl Assembler {
             }
         }
         if !self.in_progress {
-            self.start(t - f64::from(k) / f64::from(self.clock.rpm), host_us);
+            self.start(t - f64::from(k) * self.clock.slot_s, host_us);
         }
         self.fill(packet);
         self.last_host_us = host_us.or(self.last_host_us);
@@ -228,14 +231,15 @@ impl Assembler {
         let t = if c.started {
             let slots = (usize::from(repr.index) + PACKETS_PER_REV - usize::from(c.last_index))
                 % PACKETS_PER_REV;
-            c.t_last + slots as f64 / f64::from(c.rpm)
+            c.t_last + slots as f64 * c.slot_s
         } else {
             c.started = true;
             0.0
         };
         let rpm = repr.rpm();
-        if (MIN_PLAUSIBLE_RPM..=MAX_PLAUSIBLE_RPM).contains(&rpm) {
+        if rpm != c.rpm && (MIN_PLAUSIBLE_RPM..=MAX_PLAUSIBLE_RPM).contains(&rpm) {
             c.rpm = rpm;
+            c.slot_s = 1.0 / f64::from(rpm);
         }
         c.t_last = t;
         c.last_index = repr.index;
@@ -244,12 +248,7 @@ impl Assembler {
 
     fn start(&mut self, t_start_s: f64, host_us: Option<u64>) {
         let rev = &mut self.bufs[self.filling];
-        for (d, r) in rev.readings.iter_mut().enumerate() {
-            *r = Reading {
-                angle_rad: bin_angle_rad(d),
-                ..Reading::default()
-            };
-        }
+        rev.readings = EMPTY_READINGS;
         rev.seq = self.next_seq;
         rev.t_start_s = t_start_s;
         rev.host_time_us = host_us;

@@ -147,6 +147,22 @@ impl Decoder {
                     }
                 }
             }
+            // Fast path: a whole packet in the input with a good checksum is parsed in place.
+            if self.len == 0
+                && let Some(candidate) = input.get(..PACKET_LEN)
+                && let Ok(packet) = Packet::new_checked(candidate)
+                && packet.checksum_ok()
+            {
+                let repr = Repr::parse(&packet);
+                self.stats.bytes_in += PACKET_LEN as u64;
+                self.stats.packets += 1;
+                *input = &input[PACKET_LEN..];
+                return Some(Decoded {
+                    repr,
+                    checksum_ok: true,
+                });
+            }
+            // Anything else takes the general path below, which counts and resyncs.
             let take = (DECODER_BUFFER_LEN - self.len).min(input.len());
             self.buf[self.len..self.len + take].copy_from_slice(&input[..take]);
             self.len += take;

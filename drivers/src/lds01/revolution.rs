@@ -50,7 +50,7 @@ pub const fn raw_to_bin(i: usize) -> usize {
 /// The angle of bin `d` in radians.
 #[inline]
 pub fn bin_angle_rad(d: usize) -> f32 {
-    (d % READINGS_PER_REV) as f32 * (core::f32::consts::PI / 180.0)
+    (d % READINGS_PER_REV) as f32 * DEG_TO_RAD
 }
 
 /// A revolution as the assembler hands it out.
@@ -77,13 +77,28 @@ pub struct Revolution {
     pub readings: [Reading; READINGS_PER_REV],
 }
 
+/// The readings of an empty revolution: every bin at its angle, no return, invalid.
+pub const EMPTY_READINGS: [Reading; READINGS_PER_REV] = {
+    let mut readings = [Reading {
+        angle_rad: 0.0,
+        range_m: 0.0,
+        intensity: 0,
+        valid: false,
+    }; READINGS_PER_REV];
+    let mut d = 0;
+    while d < READINGS_PER_REV {
+        readings[d].angle_rad = d as f32 * DEG_TO_RAD;
+        d += 1;
+    }
+    readings
+};
+
+const DEG_TO_RAD: f32 = core::f32::consts::PI / 180.0;
+
 impl Revolution {
     /// An empty revolution: every reading invalid at its bin's angle.
     pub fn empty() -> Self {
-        let mut readings = [Reading::default(); READINGS_PER_REV];
-        for (d, r) in readings.iter_mut().enumerate() {
-            r.angle_rad = bin_angle_rad(d);
-        }
+        let readings = EMPTY_READINGS;
         Revolution {
             seq: 0,
             t_start_s: 0.0,
