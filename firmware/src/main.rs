@@ -164,13 +164,14 @@ fn print_summary(s: &Summary) {
     );
     eprintln!(
         "umbra: faults: bytes skipped {}, bad checksum {}, bad index {}, missing packets {}, \
-         repeated packets {}, incomplete revolutions {}, invalid readings {}, link lost {}, \
-         reopened {}, deadline misses {}",
+         repeated packets {}, out-of-sequence bad packets {}, incomplete revolutions {}, \
+         invalid readings {}, link lost {}, reopened {}, deadline misses {}",
         f.bytes_skipped,
         f.bad_checksum,
         f.bad_index,
         f.missing_packets,
         f.repeated_packets,
+        f.out_of_sequence_bad_packets,
         f.incomplete_revolutions,
         s.invalid_readings,
         s.link.0,

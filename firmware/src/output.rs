@@ -86,6 +86,8 @@ pub struct FaultsOut {
     pub lidar_bad_index: u64,
     /// Packets received twice.
     pub lidar_repeated_packets: u64,
+    /// Bad-checksum packets (kept under `count`) dropped for an out-of-sequence index.
+    pub lidar_out_of_sequence_bad_packets: u64,
     /// Revolutions with packets missing.
     pub lidar_incomplete_revolutions: u64,
     /// Readings dropped as invalid (no return, or outside the range window), in received
@@ -108,6 +110,7 @@ impl FaultsOut {
             compass_rejected: 0,
             lidar_bad_index: f.bad_index,
             lidar_repeated_packets: f.repeated_packets,
+            lidar_out_of_sequence_bad_packets: f.out_of_sequence_bad_packets,
             lidar_incomplete_revolutions: f.incomplete_revolutions,
             lidar_invalid_readings: invalid_readings,
             lidar_link_lost: link.0,

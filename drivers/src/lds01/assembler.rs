@@ -11,7 +11,9 @@
 //!
 //! So a lost packet never holds a revolution back. A revolution that ends with packets
 //! missing is handed out all the same, flagged incomplete, with its missing packets counted.
-//! A packet whose index equals the previous one is a repeat: counted and ignored.
+//! A packet whose index equals the previous one is a repeat: counted and ignored. A packet kept
+//! despite a failed checksum (`Count` policy) is used only if its index follows the previous
+//! packet's; otherwise its index cannot be trusted and it is dropped and counted.
 //!
 //! ## Sensor clock (`interfaces.md` §2)
 //!
@@ -72,6 +74,10 @@ pub struct AssemblerStats {
     pub missing_packets: u64,
     /// Packets received twice in a row (ignored).
     pub repeated_packets: u64,
+    /// Packets with a failed checksum (kept under the `Count` policy) dropped all the same
+    /// because their index does not follow the previous packet's: a corrupted index would
+    /// put six readings at the wrong angles and split the revolution.
+    pub out_of_sequence_bad_packets: u64,
 }
 
 #[derive(Debug, Clone, Copy)]
@@ -171,6 +177,11 @@ impl Assembler {
         }
         if self.clock.started && k == self.clock.last_index {
             self.stats.repeated_packets += 1;
+            return false;
+        }
+        let next = (usize::from(self.clock.last_index) + 1) % PACKETS_PER_REV;
+        if !packet.checksum_ok && self.clock.started && usize::from(k) != next {
+            self.stats.out_of_sequence_bad_packets += 1;
             return false;
         }
         let t = self.advance_clock(repr);
@@ -429,6 +440,28 @@ mod test {
         a.push(&pkt(1, 0, 1000), None);
         // Nominal 300 rpm → one slot = 1/300 s.
         assert!((a.sensor_time_s() - 2.0 / 300.0).abs() < 1e-9);
+    }
+
+    #[test]
+    fn bad_checksum_packet_used_only_in_sequence() {
+        let mut a = Assembler::new(AssemblerConfig::default());
+        let bad = |k| Decoded {
+            checksum_ok: false,
+            ..pkt(k, 3000, 1000)
+        };
+        for k in 0..10u8 {
+            a.push(&pkt(k, 3000, 1000), None);
+        }
+        assert!(a.push(&bad(10), None).is_none()); // in sequence: kept
+        assert!(a.push(&bad(40), None).is_none()); // a corrupted index: dropped
+        assert!(a.push(&bad(3), None).is_none()); // would split the revolution: dropped
+        assert_eq!(a.stats().out_of_sequence_bad_packets, 2);
+        for k in 11..60u8 {
+            a.push(&pkt(k, 3000, 1000), None);
+        }
+        let r = a.last().unwrap();
+        assert!(r.is_complete());
+        assert_eq!(r.bad_checksum_packets, 1);
     }
 
     #[test]

@@ -81,6 +81,8 @@ pub struct Lds01Faults {
     pub missing_packets: u64,
     /// Packets received twice in a row.
     pub repeated_packets: u64,
+    /// Bad-checksum packets kept by the `Count` policy but dropped for an out-of-sequence index.
+    pub out_of_sequence_bad_packets: u64,
     /// Revolutions handed out with packets missing.
     pub incomplete_revolutions: u64,
 }
@@ -178,6 +180,7 @@ impl Lds01Stream {
             bad_index: d.bad_index,
             missing_packets: a.missing_packets,
             repeated_packets: a.repeated_packets,
+            out_of_sequence_bad_packets: a.out_of_sequence_bad_packets,
             incomplete_revolutions: a.incomplete_revolutions,
         }
     }

@@ -1,0 +1,287 @@
+//! End-to-end tests of the `umbra` binary: the contract of `interfaces.md` (commands, exit
+//! status, the first line, the JSON output line checked against `output-line.schema.json`).
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+use serde_json::Value;
+use sim::corrupt::{Corruption, corrupt};
+use sim::lds01::{Lds01Sim, Lds01SimConfig};
+use sim::world::World;
+
+fn umbra(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_umbra"))
+        .args(args)
+        .env("RUST_LOG", "warn")
+        .output()
+        .expect("run umbra")
+}
+
+fn tmp(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("umbra-cli-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    dir.join(name)
+}
+
+fn capture(path: &Path, revolutions: usize, mix: Corruption) {
+    let mut sim = Lds01Sim::new(World::random_room(4), Lds01SimConfig::default(), 4);
+    let mut bytes = Vec::new();
+    sim.emit_revolutions(revolutions, &mut bytes);
+    let bytes = corrupt(bytes.chunks(42), mix, 4).bytes;
+    std::fs::write(path, bytes).unwrap();
+}
+
+/// The contract's JSON Schema, when `../shared/reference` is beside the repository.
+fn schema() -> Option<Value> {
+    let p = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../shared/reference/output-line.schema.json");
+    match std::fs::read_to_string(&p) {
+        Ok(s) => Some(serde_json::from_str(&s).expect("schema is JSON")),
+        Err(_) => {
+            println!("skipping schema check: {} not found", p.display());
+            None
+        }
+    }
+}
+
+/// A validator for the JSON Schema keywords the contract uses: type, required, properties,
+/// additionalProperties (as a schema), items, enum, minimum, maximum, exclusiveMinimum,
+/// minItems, maxItems. Returns the first violation with its path.
+fn validate(v: &Value, s: &Value, path: &str) -> Result<(), String> {
+    let fail = |what: &str| Err(format!("{path}: {what} (value {v})"));
+    if let Some(t) = s.get("type") {
+        let types: Vec<&str> = match t {
+            Value::String(x) => vec![x.as_str()],
+            Value::Array(xs) => xs.iter().filter_map(Value::as_str).collect(),
+            _ => vec![],
+        };
+        let ok = types.iter().any(|t| match *t {
+            "object" => v.is_object(),
+            "array" => v.is_array(),
+            "number" => v.is_number(),
+            "integer" => v.is_i64() || v.is_u64(),
+            "boolean" => v.is_boolean(),
+            "string" => v.is_string(),
+            "null" => v.is_null(),
+            _ => false,
+        });
+        if !ok {
+            return fail(&format!("not of type {t}"));
+        }
+    }
+    if let Some(e) = s.get("enum").and_then(Value::as_array)
+        && !e.contains(v)
+    {
+        return fail("not in enum");
+    }
+    if let Some(x) = v.as_f64() {
+        if s.get("minimum")
+            .and_then(Value::as_f64)
+            .is_some_and(|m| x < m)
+        {
+            return fail("below minimum");
+        }
+        if s.get("maximum")
+            .and_then(Value::as_f64)
+            .is_some_and(|m| x > m)
+        {
+            return fail("above maximum");
+        }
+        if s.get("exclusiveMinimum")
+            .and_then(Value::as_f64)
+            .is_some_and(|m| x <= m)
+        {
+            return fail("not above exclusiveMinimum");
+        }
+    }
+    if let Some(obj) = v.as_object() {
+        for r in s
+            .get("required")
+            .and_then(Value::as_array)
+            .into_iter()
+            .flatten()
+        {
+            let r = r.as_str().unwrap_or_default();
+            if !obj.contains_key(r) {
+                return fail(&format!("missing required {r}"));
+            }
+        }
+        let props = s.get("properties").and_then(Value::as_object);
+        for (k, val) in obj {
+            let sub = props
+                .and_then(|p| p.get(k))
+                .or(s.get("additionalProperties"));
+            if let Some(sub) = sub.filter(|x| x.is_object()) {
+                validate(val, sub, &format!("{path}.{k}"))?;
+            }
+        }
+    }
+    if let Some(arr) = v.as_array() {
+        let n = arr.len() as u64;
+        if s.get("minItems")
+            .and_then(Value::as_u64)
+            .is_some_and(|m| n < m)
+        {
+            return fail("too few items");
+        }
+        if s.get("maxItems")
+            .and_then(Value::as_u64)
+            .is_some_and(|m| n > m)
+        {
+            return fail("too many items");
+        }
+        if let Some(items) = s.get("items") {
+            for (i, x) in arr.iter().enumerate() {
+                validate(x, items, &format!("{path}[{i}]"))?;
+            }
+        }
+    }
+    Ok(())
+}
+
+#[test]
+fn run_without_hardware_uses_the_simulated_robot() {
+    let out = umbra(&["run", "--frames", "3", "--jsonl", "-", "--quiet"]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let stdout = String::from_utf8(out.stdout).unwrap();
+    let mut lines = stdout.lines();
+    let first = lines.next().unwrap();
+    assert!(first.contains("simulated robot"), "first line: {first}");
+    let frames: Vec<Value> = lines.map(|l| serde_json::from_str(l).unwrap()).collect();
+    assert_eq!(frames.len(), 3);
+    for (i, f) in frames.iter().enumerate() {
+        assert_eq!(f["frame"], i as u64);
+        assert_eq!(f["lidar"]["packets"], 60);
+    }
+}
+
+#[test]
+fn replay_of_a_noisy_capture_writes_valid_lines_with_faults() {
+    let cap = tmp("noisy.bin");
+    let jsonl = tmp("noisy.jsonl");
+    capture(&cap, 40, Corruption::ISSUE_MIX);
+    let out = umbra(&[
+        "replay",
+        cap.to_str().unwrap(),
+        "--jsonl",
+        jsonl.to_str().unwrap(),
+        "--quiet",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let text = std::fs::read_to_string(&jsonl).unwrap();
+    let lines: Vec<Value> = text
+        .lines()
+        .map(|l| serde_json::from_str(l).unwrap())
+        .collect();
+    assert!(lines.len() >= 39, "{} frames", lines.len());
+    if let Some(schema) = schema() {
+        for l in &lines {
+            validate(l, &schema, "$").unwrap();
+        }
+    }
+    let last = lines.last().unwrap();
+    assert!(last["faults"]["lidar_bad_checksum"].as_u64().unwrap() > 0);
+    assert!(last["faults"]["lidar_bytes_skipped"].as_u64().unwrap() > 0);
+    // Frames are in order on the sensor clock, ~0.2 s apart.
+    for w in lines.windows(2) {
+        assert!(w[1]["t"].as_f64() > w[0]["t"].as_f64());
+    }
+    let span = last["t"].as_f64().unwrap() - lines[0]["t"].as_f64().unwrap();
+    assert!((6.0..9.0).contains(&span), "40 revolutions span {span} s");
+}
+
+#[test]
+fn replay_frame_and_seconds_limits() {
+    let cap = tmp("clean.bin");
+    capture(&cap, 30, Corruption::NONE);
+    let count = |args: &[&str]| {
+        let mut a = vec!["replay", cap.to_str().unwrap(), "--jsonl", "-", "--quiet"];
+        a.extend_from_slice(args);
+        let out = umbra(&a);
+        assert!(out.status.success());
+        String::from_utf8(out.stdout)
+            .unwrap()
+            .lines()
+            .filter(|l| l.starts_with('{'))
+            .count()
+    };
+    assert_eq!(count(&[]), 30);
+    assert_eq!(count(&["--frames", "7"]), 7);
+    // Sensor clock: 2 s ≈ 10 revolutions at ~300 rpm.
+    let n = count(&["--seconds", "2"]);
+    assert!((9..=11).contains(&n), "{n} frames in 2 s");
+}
+
+#[test]
+fn errors_name_what_is_wrong_and_exit_2_or_1() {
+    let out = umbra(&["replay", "/nonexistent/capture.bin"]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("/nonexistent/capture.bin"));
+
+    let cfg = tmp("bad.toml");
+    std::fs::write(&cfg, "[lidar]\nmax_range_m = 0.05\n").unwrap();
+    let out = umbra(&["run", "--frames", "1", "--config", cfg.to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("lidar.max_range_m") && err.contains("bad.toml"),
+        "{err}"
+    );
+
+    std::fs::write(&cfg, "[lidar]\nchecksum = \"sometimes\"\n").unwrap();
+    let out = umbra(&["run", "--frames", "1", "--config", cfg.to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("checksum"));
+
+    let out = umbra(&["run", "--frames", "1", "--lidar", "/dev/umbra-no-such-port"]);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("/dev/umbra-no-such-port"));
+
+    let out = umbra(&["run", "--frames", "x"]);
+    assert_eq!(out.status.code(), Some(2));
+    let out = umbra(&["run", "--lidar-model", "ld06", "--frames", "1"]);
+    assert_eq!(out.status.code(), Some(2));
+}
+
+#[test]
+fn count_policy_keeps_and_counts_bad_packets() {
+    let cap = tmp("count.bin");
+    capture(
+        &cap,
+        20,
+        Corruption {
+            bit_flip: 1e-3,
+            ..Corruption::NONE
+        },
+    );
+    let cfg = tmp("count.toml");
+    std::fs::write(&cfg, "[lidar]\nchecksum = \"count\"\n").unwrap();
+    let run = |extra: &[&str]| -> Value {
+        let mut a = vec!["replay", cap.to_str().unwrap(), "--jsonl", "-", "--quiet"];
+        a.extend_from_slice(extra);
+        let out = umbra(&a);
+        assert!(out.status.success());
+        let s = String::from_utf8(out.stdout).unwrap();
+        serde_json::from_str(s.lines().rfind(|l| l.starts_with('{')).unwrap()).unwrap()
+    };
+    let verify = run(&[]);
+    let count = run(&["--config", cfg.to_str().unwrap()]);
+    let bad = verify["faults"]["lidar_bad_checksum"].as_u64().unwrap();
+    assert!(bad > 0);
+    assert_eq!(count["faults"]["lidar_bad_checksum"].as_u64().unwrap(), bad);
+    // Under `verify` every bad packet goes missing; under `count` only those whose sync or
+    // index byte was hit (a flipped index can also split a revolution), far fewer.
+    let missing_verify = verify["faults"]["lidar_missing_packets"].as_u64().unwrap();
+    let missing_count = count["faults"]["lidar_missing_packets"].as_u64().unwrap();
+    println!("bad checksum {bad}; missing: verify {missing_verify}, count {missing_count}");
+    assert!(missing_verify >= bad);
+    assert!(missing_count * 2 < missing_verify);
+}
