@@ -1,5 +1,6 @@
 //! The frame loop as it stands: ingest → output. One frame per LiDAR revolution.
 //!
+//! `timing_ms.ingest` is the time spent decoding the frame's bytes (not waiting for them).
 //! Bytes are read into one fixed buffer ([`READ_CHUNK`] bytes), fed to the LDS-01 stream,
 //! and each finished revolution becomes a frame: a statistics line, a JSON line, or both.
 //! Pose, Method A and Method B join this loop as their issues land.
@@ -9,7 +10,7 @@ use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
 
-use drivers::lds01::{Lds01Config, Lds01Faults, Lds01Stream, Revolution};
+use drivers::lds01::{Lds01Config, Lds01Faults, Lds01Stream};
 
 use crate::output::{FaultsOut, LidarOut, OutputLine, PoseOut, TimingOut, stats_line};
 use crate::source::{LidarSource, Pacing, SourceRead};
@@ -96,23 +97,21 @@ pub fn run(
                 break 'outer "time limit";
             }
         }
-        let t0 = Instant::now();
         let host_us = || start.elapsed().as_micros() as u64;
         let n = match source.read(&mut buf) {
             SourceRead::Data(n) => n,
             SourceRead::Idle => {
                 let now = host_us();
-                if stream.poll(now, |_| {}) {
-                    ingest += t0.elapsed();
-                    if emit_frame_ref(&stream, source, &mut opts, &mut summary, &mut ingest)? {
-                        break 'outer "frame limit";
-                    }
+                if stream.poll(now, |_| {})
+                    && emit_frame(&stream, source, &mut opts, &mut summary, &mut ingest)?
+                {
+                    break 'outer "frame limit";
                 }
                 continue;
             }
             SourceRead::End => {
                 if stream.finish(|_| {}) {
-                    emit_frame_ref(&stream, source, &mut opts, &mut summary, &mut ingest)?;
+                    emit_frame(&stream, source, &mut opts, &mut summary, &mut ingest)?;
                 }
                 break 'outer "end of input";
             }
@@ -136,7 +135,7 @@ pub fn run(
             if !done {
                 break;
             }
-            let limit = emit_frame_ref(&stream, source, &mut opts, &mut summary, &mut ingest)?;
+            let limit = emit_frame(&stream, source, &mut opts, &mut summary, &mut ingest)?;
             if limit {
                 break 'outer "frame limit";
             }
@@ -162,28 +161,18 @@ pub fn run(
     Ok(summary)
 }
 
-fn emit_frame_ref(
-    stream: &Lds01Stream,
-    source: &LidarSource,
-    opts: &mut RunOptions,
-    summary: &mut Summary,
-    ingest: &mut Duration,
-) -> std::io::Result<bool> {
-    match stream.last_revolution() {
-        Some(rev) => emit_frame(rev, stream, source, opts, summary, ingest),
-        None => Ok(false),
-    }
-}
-
-/// Writes one frame; returns `true` when the frame limit is reached.
+/// Writes the stream's last finished revolution as one frame; returns `true` when the frame
+/// limit is reached.
 fn emit_frame(
-    rev: &Revolution,
     stream: &Lds01Stream,
     source: &LidarSource,
     opts: &mut RunOptions,
     summary: &mut Summary,
     ingest: &mut Duration,
 ) -> std::io::Result<bool> {
+    let Some(rev) = stream.last_revolution() else {
+        return Ok(false);
+    };
     let t_frame = Instant::now();
     let frame = summary.frames;
     let valid = rev.valid_count() as u32;
