@@ -94,9 +94,8 @@ impl LidarSource {
             LidarSource::Serial(link) => format!("LDS-01 on serial port {}", link.path()),
             LidarSource::Capture { path, .. } => format!("raw LDS-01 capture {}", path.display()),
             LidarSource::Sim { sim, room_seed } => format!(
-                "no hardware named: running on the built-in simulated robot (LDS-01, room seed {room_seed}, {:.1} × {:.1} m room)",
-                sim.world().size.0,
-                sim.world().size.1
+                "no hardware named: running on the built-in simulated robot (LDS-01; seed {room_seed}: {})",
+                sim.world().describe()
             ),
         }
     }

@@ -8,11 +8,13 @@
 //! |----------------|--------------------------------------------------------------|
 //! | [`geometry`]   | 2D points and rigid poses in REP 103 (x forward, y left, CCW) |
 //! | [`class`]      | the object classes both methods report, with their wire names |
+//! | [`raster`]     | three revolutions as the 64 × 384 × 3 image of Method B (bit-exact spec) |
 //!
-//! The global point cloud, DBSCAN, walls and doors, features, the scan raster and YOLO decoding
+//! The global point cloud, DBSCAN, walls and doors, features and YOLO decoding
 //! arrive with their issues; each capacity is a named constant listed in `memory-budget.md`.
 #![cfg_attr(not(any(test, feature = "std")), no_std)]
 #![deny(unsafe_code, missing_docs)]
 
 pub mod class;
 pub mod geometry;
+pub mod raster;

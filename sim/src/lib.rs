@@ -1,19 +1,28 @@
 //! # umbra sim
 //!
-//! A simulated robot whose sensors emit the bytes the real parts put on their wires, so that
-//! the simulated robot exercises the same decoders as a real one. Every run takes a seed and is
-//! reproducible.
+//! A TurtleBot3 in seeded random rooms whose sensors put out what the real parts put on their
+//! wires, so that the simulated robot exercises the same decoders as a real one; with the
+//! ground truth of every reading for training and scoring. Every run takes a seed and is
+//! reproducible: same seed, byte-identical output.
 //!
-//! | module      | owns                                                                |
-//! |-------------|---------------------------------------------------------------------|
-//! | [`world`]   | a seeded rectangular room with box obstacles; ray casting            |
-//! | [`lds01`]   | the LDS-01: per-reading timing, rpm jitter, noise, dropouts, packets |
-//! | [`corrupt`] | a noisy serial line: bit flips, inserted and dropped bytes, with truth |
-//!
-//! The full simulator (room shapes, doors, furniture classes, encoders, compass, datasets)
-//! grows here with its issue; this first cut is what the LiDAR driver and `umbra run` need.
+//! | module        | owns                                                                 |
+//! |---------------|----------------------------------------------------------------------|
+//! | [`world`]     | rooms (rectangle, L, two rooms + corridor), doors, furniture, clutter |
+//! | [`grid`]      | the spatial index and grid-walking ray caster                         |
+//! | [`robot`]     | differential drive (Burger constants), slip, encoders, motion scripts |
+//! | [`compass`]   | magnetometer: earth field, hard iron, noise, local disturbances       |
+//! | [`lds01`]     | LDS-01 reading model and the packet byte source                       |
+//! | [`scenario`]  | world + robot + sensors stepped one revolution (frame) at a time      |
+//! | [`labels`]    | Method B boxes from footprints, per-reading labels                    |
+//! | [`dataset`]   | dataset writers: YOLO layout, Method A labels, replay recordings      |
+//! | [`picture`]   | a PNG of a scene for people to look at                                |
+//! | [`corrupt`]   | a noisy serial line: bit flips, inserted and dropped bytes, with truth |
 #![deny(unsafe_code, missing_docs)]
 
+pub mod compass;
 pub mod corrupt;
+pub mod grid;
 pub mod lds01;
+pub mod robot;
+pub mod scenario;
 pub mod world;

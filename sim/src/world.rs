@@ -1,115 +1,791 @@
-//! A seeded 2D world as seen at LiDAR height: a rectangular room (walls as inner faces) with
-//! square boxes, and ray casting against its segments.
+//! A seeded 2D world as seen at LiDAR height (~0.17 m): rooms with 0.1 m walls, doorways with
+//! jambs, furniture of the four classes' shapes, and clutter that is none of them.
+//!
+//! Room kinds ([`RoomKind`]): a rectangle 3–8 m a side, an L-shape (a rectangle with a corner
+//! cut out), and two rooms joined by a corridor. Walls are solid 0.1 m rectangles built outside
+//! the free outline, so a ray sees the inner face, and through a doorway the jamb faces and
+//! whatever lies beyond (a hallway wall for single rooms, the corridor and the other room).
+//!
+//! Furniture (`methods.md`, "World geometry"): a chair is four ~3 cm legs on a ~0.4 m square, a
+//! desk four ~5 cm legs on ~0.8 × 1.6 m, a box a solid ~0.4 × 0.6 m rectangle, each scaled by
+//! U(0.8, 1.2), placed uniformly with random rotation, no overlaps and ≥ 0.7 m between
+//! footprints. Clutter: round bins, round pillars, and pairs of people's legs.
+//!
+//! Every surface carries a [`Surface`] label (what a ray that hits it has hit) and a
+//! reflectivity that drives the LiDAR's dropouts and intensity.
 
+use perception::class::ObjectClass;
 use perception::geometry::Point2;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
-/// A line segment, metres.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Segment {
-    /// One end.
-    pub a: Point2,
-    /// The other end.
-    pub b: Point2,
+use crate::grid::Grid;
+
+/// Wall thickness, metres.
+pub const WALL_T: f32 = 0.1;
+/// Clearance kept between furniture footprints (room for the robot), metres.
+pub const CLEARANCE: f32 = 0.7;
+
+/// What a surface belongs to.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum Surface {
+    /// A wall.
+    Wall,
+    /// A door frame (jamb) of door `n` (index into [`World::doors`]).
+    DoorFrame(u16),
+    /// Furniture `n` (index into [`World::objects`]).
+    Object(u16),
+    /// Clutter item `n` (index into [`World::clutter`]): none of the classes.
+    Clutter(u16),
 }
 
-/// A room: segments in the world frame, and a free spot for the robot.
+/// A ray-castable primitive.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Shape {
+    /// A line segment.
+    Segment {
+        /// One end.
+        a: Point2,
+        /// The other end.
+        b: Point2,
+    },
+    /// A circle (legs, bins, pillars).
+    Circle {
+        /// Centre.
+        c: Point2,
+        /// Radius.
+        r: f32,
+    },
+}
+
+impl Shape {
+    /// Axis-aligned bounds (min, max).
+    pub fn bounds(&self) -> (Point2, Point2) {
+        match *self {
+            Shape::Segment { a, b } => (
+                Point2::new(a.x.min(b.x), a.y.min(b.y)),
+                Point2::new(a.x.max(b.x), a.y.max(b.y)),
+            ),
+            Shape::Circle { c, r } => {
+                (Point2::new(c.x - r, c.y - r), Point2::new(c.x + r, c.y + r))
+            }
+        }
+    }
+
+    /// Distance along the ray `o + t·d` (unit `d`) to this shape and the cosine of the angle of
+    /// incidence, if it is hit at `t > 0`.
+    #[inline]
+    pub fn intersect(&self, o: Point2, d: Point2) -> Option<(f32, f32)> {
+        match *self {
+            Shape::Segment { a, b } => {
+                let e = b - a;
+                let denom = d.x * e.y - d.y * e.x;
+                if denom.abs() < 1e-12 {
+                    return None;
+                }
+                let w = a - o;
+                let t = (w.x * e.y - w.y * e.x) / denom;
+                let u = (w.x * d.y - w.y * d.x) / denom;
+                if t > 1e-6 && (0.0..=1.0).contains(&u) {
+                    let len = (e.x * e.x + e.y * e.y).sqrt();
+                    Some((t, (denom / len).abs()))
+                } else {
+                    None
+                }
+            }
+            Shape::Circle { c, r } => {
+                let m = o - c;
+                let b = m.x * d.x + m.y * d.y;
+                let cc = m.x * m.x + m.y * m.y - r * r;
+                if cc > 0.0 && b > 0.0 {
+                    return None;
+                }
+                let disc = b * b - cc;
+                if disc < 0.0 {
+                    return None;
+                }
+                let t = -b - disc.sqrt();
+                if t <= 1e-6 {
+                    return None; // origin inside the circle
+                }
+                let p = Point2::new(m.x + t * d.x, m.y + t * d.y);
+                let cos = ((p.x * d.x + p.y * d.y) / r).abs();
+                Some((t, cos))
+            }
+        }
+    }
+
+    /// Distance from `p` to this shape's outline.
+    pub fn distance(&self, p: Point2) -> f32 {
+        match *self {
+            Shape::Segment { a, b } => {
+                let e = b - a;
+                let l2 = e.x * e.x + e.y * e.y;
+                let t = if l2 > 0.0 {
+                    (((p - a).x * e.x + (p - a).y * e.y) / l2).clamp(0.0, 1.0)
+                } else {
+                    0.0
+                };
+                p.distance(Point2::new(a.x + t * e.x, a.y + t * e.y))
+            }
+            Shape::Circle { c, r } => (p.distance(c) - r).max(0.0),
+        }
+    }
+}
+
+/// A primitive with what it belongs to and how well it reflects.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Prim {
+    /// Geometry.
+    pub shape: Shape,
+    /// Owner.
+    pub surface: Surface,
+    /// Reflectivity in (0, 1]: dark or glossy surfaces return less often.
+    pub reflectivity: f32,
+}
+
+/// A piece of furniture (ground truth).
+#[derive(Debug, Clone, PartialEq)]
+pub struct ObjectTruth {
+    /// Class.
+    pub class: ObjectClass,
+    /// Centre, world frame.
+    pub centre: Point2,
+    /// Rotation, radians.
+    pub yaw: f32,
+    /// Footprint corners, counter-clockwise, world frame.
+    pub footprint: [Point2; 4],
+}
+
+/// A doorway (ground truth).
+#[derive(Debug, Clone, PartialEq)]
+pub struct DoorTruth {
+    /// Centre of the gap.
+    pub centre: Point2,
+    /// Clear width of the gap, metres.
+    pub width: f32,
+    /// Direction along the wall, radians.
+    pub wall_angle: f32,
+    /// Footprint of the frame (gap plus both jambs), counter-clockwise.
+    pub footprint: [Point2; 4],
+}
+
+/// A clutter item (ground truth).
+#[derive(Debug, Clone, PartialEq)]
+pub struct ClutterTruth {
+    /// What it is: `bin`, `pillar` or `legs`.
+    pub kind: &'static str,
+    /// Centre.
+    pub centre: Point2,
+}
+
+/// The room layouts.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum RoomKind {
+    /// A rectangle.
+    Rect,
+    /// A rectangle with a corner cut out.
+    LShape,
+    /// Two rectangles joined by a corridor.
+    TwoRooms,
+}
+
+impl RoomKind {
+    /// Name used in file names and reports.
+    pub fn name(self) -> &'static str {
+        match self {
+            RoomKind::Rect => "rect",
+            RoomKind::LShape => "lshape",
+            RoomKind::TwoRooms => "tworooms",
+        }
+    }
+}
+
+/// World generation settings.
+#[derive(Debug, Clone, PartialEq)]
+pub struct WorldConfig {
+    /// Layouts to draw from (uniformly).
+    pub kinds: Vec<RoomKind>,
+    /// Furniture per square metre of floor (then rounded, at least 2).
+    pub furniture_density: f32,
+    /// Chance that a single room gets a doorway.
+    pub door_chance: f64,
+    /// Clutter items: drawn uniformly from 0..=max.
+    pub max_clutter: usize,
+}
+
+impl Default for WorldConfig {
+    fn default() -> Self {
+        WorldConfig {
+            kinds: vec![RoomKind::Rect, RoomKind::LShape, RoomKind::TwoRooms],
+            furniture_density: 0.2,
+            door_chance: 0.8,
+            max_clutter: 3,
+        }
+    }
+}
+
+/// A generated world.
 #[derive(Debug, Clone)]
 pub struct World {
-    /// Room width (x) and depth (y), metres; the room spans [0, w] × [0, h].
-    pub size: (f32, f32),
-    /// Every surface a ray can hit.
-    pub segments: Vec<Segment>,
-    /// Box centres and half sizes (for tests and labels).
-    pub boxes: Vec<(Point2, f32)>,
-    /// A spot at least 0.7 m from every surface.
+    /// Layout.
+    pub kind: RoomKind,
+    /// Every primitive.
+    pub prims: Vec<Prim>,
+    /// Furniture.
+    pub objects: Vec<ObjectTruth>,
+    /// Doorways.
+    pub doors: Vec<DoorTruth>,
+    /// Clutter.
+    pub clutter: Vec<ClutterTruth>,
+    /// Axis-aligned free rectangles (min, max) that make up the floor.
+    pub floor: Vec<(Point2, Point2)>,
+    /// A spot with clearance for the robot to start.
     pub robot_start: Point2,
+    /// Spatial index over `prims`.
+    pub grid: Grid,
+}
+
+fn rect_corners(c: Point2, half: (f32, f32), yaw: f32) -> [Point2; 4] {
+    let (s, co) = yaw.sin_cos();
+    let r = |x: f32, y: f32| Point2::new(c.x + co * x - s * y, c.y + s * x + co * y);
+    [
+        r(-half.0, -half.1),
+        r(half.0, -half.1),
+        r(half.0, half.1),
+        r(-half.0, half.1),
+    ]
+}
+
+struct Builder {
+    rng: ChaCha8Rng,
+    prims: Vec<Prim>,
+    objects: Vec<ObjectTruth>,
+    doors: Vec<DoorTruth>,
+    clutter: Vec<ClutterTruth>,
+    floor: Vec<(Point2, Point2)>,
+    /// Keep-out discs (centre, radius) of everything placed so far, for spacing.
+    keep_out: Vec<(Point2, f32)>,
+}
+
+impl Builder {
+    fn polygon(&mut self, corners: &[Point2], surface: Surface, reflectivity: f32) {
+        for i in 0..corners.len() {
+            self.prims.push(Prim {
+                shape: Shape::Segment {
+                    a: corners[i],
+                    b: corners[(i + 1) % corners.len()],
+                },
+                surface,
+                reflectivity,
+            });
+        }
+    }
+
+    fn aabb(&mut self, min: Point2, max: Point2, surface: Surface, reflectivity: f32) {
+        if max.x - min.x <= 1e-4 || max.y - min.y <= 1e-4 {
+            return;
+        }
+        self.polygon(
+            &[
+                min,
+                Point2::new(max.x, min.y),
+                max,
+                Point2::new(min.x, max.y),
+            ],
+            surface,
+            reflectivity,
+        );
+    }
+
+    fn circle(&mut self, c: Point2, r: f32, surface: Surface, reflectivity: f32) {
+        self.prims.push(Prim {
+            shape: Shape::Circle { c, r },
+            surface,
+            reflectivity,
+        });
+    }
+
+    fn wall_reflectivity(&mut self) -> f32 {
+        self.rng.random_range(0.75..1.0)
+    }
+
+    /// A straight wall of thickness `WALL_T` from `p` to `q` (axis-aligned), built on the side
+    /// `outward` (unit normal), with an optional doorway gap `[g0, g1]` measured from `p`.
+    fn wall(&mut self, p: Point2, q: Point2, outward: Point2, gap: Option<(f32, f32)>) {
+        let refl = self.wall_reflectivity();
+        let len = p.distance(q);
+        let dir = Point2::new((q.x - p.x) / len, (q.y - p.y) / len);
+        let along = |t: f32| Point2::new(p.x + dir.x * t, p.y + dir.y * t);
+        let piece = |b: &mut Builder, t0: f32, t1: f32| {
+            let a = along(t0);
+            let c = along(t1);
+            let a2 = Point2::new(c.x + outward.x * WALL_T, c.y + outward.y * WALL_T);
+            let min = Point2::new(a.x.min(a2.x), a.y.min(a2.y));
+            let max = Point2::new(a.x.max(a2.x), a.y.max(a2.y));
+            b.aabb(min, max, Surface::Wall, refl);
+        };
+        match gap {
+            None => piece(self, 0.0, len),
+            Some((g0, g1)) => {
+                piece(self, 0.0, g0);
+                piece(self, g1, len);
+                self.door(along(g0), along(g1), dir, outward);
+            }
+        }
+    }
+
+    /// Jambs at both ends of a gap from `a` to `b` in a wall running along `dir`.
+    fn door(&mut self, a: Point2, b: Point2, dir: Point2, outward: Point2) {
+        let id = self.doors.len() as u16;
+        let refl = self.rng.random_range(0.5..0.95);
+        let jamb_w = 0.04;
+        let reveal = 0.02; // the frame stands proud of the wall on both sides
+        let mk = |at: Point2, sign: f32| -> [Point2; 4] {
+            // From the gap edge `at`, the jamb extends `jamb_w` into the wall side (sign).
+            let o0 = -reveal;
+            let o1 = WALL_T + reveal;
+            let p = |s: f32, o: f32| {
+                Point2::new(
+                    at.x + dir.x * s * sign + outward.x * o,
+                    at.y + dir.y * s * sign + outward.y * o,
+                )
+            };
+            [p(0.0, o0), p(jamb_w, o0), p(jamb_w, o1), p(0.0, o1)]
+        };
+        let left = mk(a, -1.0);
+        let right = mk(b, 1.0);
+        self.polygon(&left, Surface::DoorFrame(id), refl);
+        self.polygon(&right, Surface::DoorFrame(id), refl);
+        let width = a.distance(b);
+        let centre = Point2::new(
+            (a.x + b.x) / 2.0 + outward.x * WALL_T / 2.0,
+            (a.y + b.y) / 2.0 + outward.y * WALL_T / 2.0,
+        );
+        let half_len = width / 2.0 + jamb_w;
+        let half_t = WALL_T / 2.0 + reveal;
+        let wall_angle = dir.y.atan2(dir.x);
+        self.doors.push(DoorTruth {
+            centre,
+            width,
+            wall_angle,
+            footprint: rect_corners(centre, (half_len, half_t), wall_angle),
+        });
+        self.keep_out.push((centre, half_len));
+    }
+
+    /// Walls around an axis-aligned rectilinear outline (counter-clockwise), with a doorway in
+    /// edge `door_edge` if given.
+    fn outline(
+        &mut self,
+        v: &[Point2],
+        door: Option<(usize, f32)>,
+    ) -> Option<(Point2, Point2, Point2)> {
+        let n = v.len();
+        let mut door_out = None;
+        for i in 0..n {
+            let (p, q) = (v[i], v[(i + 1) % n]);
+            let len = p.distance(q);
+            let dir = Point2::new((q.x - p.x) / len, (q.y - p.y) / len);
+            // Counter-clockwise outline: the outside is to the right of the edge.
+            let outward = Point2::new(dir.y, -dir.x);
+            // Extend across convex corners so that corners are closed.
+            let convex = |a: Point2, b: Point2, c: Point2| {
+                (b.x - a.x) * (c.y - b.y) - (b.y - a.y) * (c.x - b.x) > 0.0
+            };
+            let ext0 = if convex(v[(i + n - 1) % n], p, q) {
+                WALL_T
+            } else {
+                0.0
+            };
+            let ext1 = if convex(p, q, v[(i + 2) % n]) {
+                WALL_T
+            } else {
+                0.0
+            };
+            let p2 = Point2::new(p.x - dir.x * ext0, p.y - dir.y * ext0);
+            let q2 = Point2::new(q.x + dir.x * ext1, q.y + dir.y * ext1);
+            let gap = door.filter(|(e, _)| *e == i).map(|(_, w)| {
+                let g0 = self.rng.random_range(0.3..(len - w - 0.3).max(0.31)) + ext0;
+                door_out = Some((
+                    Point2::new(p2.x + dir.x * (g0 + w / 2.0), p2.y + dir.y * (g0 + w / 2.0)),
+                    dir,
+                    outward,
+                ));
+                (g0, g0 + w)
+            });
+            self.wall(p2, q2, outward, gap);
+        }
+        door_out
+    }
+
+    /// A hallway wall beyond a doorway so that rays leaving the room see something.
+    fn hallway(&mut self, door_centre: Point2, dir: Point2, outward: Point2) {
+        let dist = self.rng.random_range(1.2..2.0);
+        let half = self.rng.random_range(2.0..3.5);
+        let c = Point2::new(
+            door_centre.x + outward.x * dist,
+            door_centre.y + outward.y * dist,
+        );
+        let p = Point2::new(c.x - dir.x * half, c.y - dir.y * half);
+        let q = Point2::new(c.x + dir.x * half, c.y + dir.y * half);
+        self.wall(p, q, outward, None);
+    }
+
+    fn fits(&self, c: Point2, r: f32, gap: f32) -> bool {
+        let inside = self.floor.iter().any(|(lo, hi)| {
+            c.x - r >= lo.x + 0.15
+                && c.x + r <= hi.x - 0.15
+                && c.y - r >= lo.y + 0.15
+                && c.y + r <= hi.y - 0.15
+        });
+        inside
+            && self
+                .keep_out
+                .iter()
+                .all(|(o, or)| c.distance(*o) >= r + or + gap)
+    }
+
+    fn random_floor_point(&mut self) -> Point2 {
+        let total: f32 = self
+            .floor
+            .iter()
+            .map(|(a, b)| (b.x - a.x) * (b.y - a.y))
+            .sum();
+        let mut pick = self.rng.random_range(0.0..total);
+        let mut chosen = self.floor[0];
+        for f in &self.floor {
+            let area = (f.1.x - f.0.x) * (f.1.y - f.0.y);
+            if pick < area {
+                chosen = *f;
+                break;
+            }
+            pick -= area;
+        }
+        Point2::new(
+            self.rng.random_range(chosen.0.x..chosen.1.x),
+            self.rng.random_range(chosen.0.y..chosen.1.y),
+        )
+    }
+
+    fn furniture(&mut self, class: ObjectClass) -> bool {
+        let scale = self.rng.random_range(0.8..1.2f32);
+        let (half, leg) = match class {
+            ObjectClass::Chair => ((0.2 * scale, 0.2 * scale), Some(0.015 * scale)),
+            ObjectClass::Desk => ((0.8 * scale, 0.4 * scale), Some(0.025 * scale)),
+            ObjectClass::Box => ((0.3 * scale, 0.2 * scale), None),
+            ObjectClass::DoorFrame => return false,
+        };
+        let radius = (half.0 * half.0 + half.1 * half.1).sqrt();
+        for _ in 0..60 {
+            let c = self.random_floor_point();
+            if !self.fits(c, radius, CLEARANCE) {
+                continue;
+            }
+            let yaw = self
+                .rng
+                .random_range(-core::f32::consts::PI..core::f32::consts::PI);
+            let id = Surface::Object(self.objects.len() as u16);
+            let footprint = rect_corners(c, half, yaw);
+            match leg {
+                Some(r) => {
+                    let refl = match class {
+                        ObjectClass::Desk => self.rng.random_range(0.25..0.7),
+                        _ => self.rng.random_range(0.35..0.9),
+                    };
+                    for leg_c in rect_corners(c, (half.0 - r, half.1 - r), yaw) {
+                        self.circle(leg_c, r, id, refl);
+                    }
+                }
+                None => {
+                    let refl = self.rng.random_range(0.55..0.9);
+                    self.polygon(&footprint, id, refl);
+                }
+            }
+            self.objects.push(ObjectTruth {
+                class,
+                centre: c,
+                yaw,
+                footprint,
+            });
+            self.keep_out.push((c, radius));
+            return true;
+        }
+        false
+    }
+
+    fn clutter_item(&mut self) {
+        let kind = ["bin", "pillar", "legs"][self.rng.random_range(0..3)];
+        let r = match kind {
+            "bin" => self.rng.random_range(0.12..0.2),
+            "pillar" => self.rng.random_range(0.1..0.25),
+            _ => 0.2,
+        };
+        for _ in 0..40 {
+            let c = self.random_floor_point();
+            if !self.fits(c, r, CLEARANCE) {
+                continue;
+            }
+            let id = Surface::Clutter(self.clutter.len() as u16);
+            match kind {
+                "legs" => {
+                    let yaw: f32 = self.rng.random_range(0.0..core::f32::consts::PI);
+                    let refl = self.rng.random_range(0.2..0.7);
+                    let lr = self.rng.random_range(0.05..0.07);
+                    let (s, co) = yaw.sin_cos();
+                    self.circle(Point2::new(c.x + co * 0.1, c.y + s * 0.1), lr, id, refl);
+                    self.circle(Point2::new(c.x - co * 0.1, c.y - s * 0.1), lr, id, refl);
+                }
+                _ => {
+                    let refl = self.rng.random_range(0.4..0.95);
+                    self.circle(c, r, id, refl);
+                }
+            }
+            self.clutter.push(ClutterTruth { kind, centre: c });
+            self.keep_out.push((c, r));
+            return;
+        }
+    }
 }
 
 impl World {
-    /// A random room 3–8 m a side with 2–5 boxes 0.3–0.6 m wide, from `seed`.
-    pub fn random_room(seed: u64) -> World {
-        let mut rng = ChaCha8Rng::seed_from_u64(seed);
-        let w = rng.random_range(3.0..8.0f32);
-        let h = rng.random_range(3.0..8.0f32);
-        let mut world = World {
-            size: (w, h),
-            segments: Vec::new(),
-            boxes: Vec::new(),
-            robot_start: Point2::new(w / 2.0, h / 2.0),
+    /// A random world from `seed`.
+    pub fn generate(seed: u64, cfg: &WorldConfig) -> World {
+        let mut b = Builder {
+            rng: ChaCha8Rng::seed_from_u64(seed),
+            prims: Vec::new(),
+            objects: Vec::new(),
+            doors: Vec::new(),
+            clutter: Vec::new(),
+            floor: Vec::new(),
+            keep_out: Vec::new(),
         };
-        let corners = [
-            Point2::new(0.0, 0.0),
-            Point2::new(w, 0.0),
-            Point2::new(w, h),
-            Point2::new(0.0, h),
-        ];
-        for i in 0..4 {
-            world.segments.push(Segment {
-                a: corners[i],
-                b: corners[(i + 1) % 4],
-            });
-        }
-        let n_boxes = rng.random_range(2..=5);
-        let mut tries = 0;
-        while world.boxes.len() < n_boxes && tries < 200 {
-            tries += 1;
-            let half = rng.random_range(0.15..0.3f32);
-            let c = Point2::new(
-                rng.random_range(half + 0.2..w - half - 0.2),
-                rng.random_range(half + 0.2..h - half - 0.2),
-            );
-            let clear_of_robot = c.distance(world.robot_start) > half * 1.5 + 0.7;
-            let clear_of_boxes = world
-                .boxes
-                .iter()
-                .all(|(o, oh)| c.distance(*o) > (half + oh) * 1.5 + 0.7);
-            if clear_of_robot && clear_of_boxes {
-                world.add_box(c, half);
+        let kinds = if cfg.kinds.is_empty() {
+            vec![RoomKind::Rect]
+        } else {
+            cfg.kinds.clone()
+        };
+        let kind = kinds[b.rng.random_range(0..kinds.len())];
+        let p = Point2::new;
+        match kind {
+            RoomKind::Rect | RoomKind::LShape => {
+                let w = b.rng.random_range(3.0..8.0f32);
+                let h = b.rng.random_range(3.0..8.0f32);
+                let outline: Vec<Point2> = if kind == RoomKind::Rect {
+                    b.floor.push((p(0.0, 0.0), p(w, h)));
+                    vec![p(0.0, 0.0), p(w, 0.0), p(w, h), p(0.0, h)]
+                } else {
+                    let a = b.rng.random_range(0.35..0.6) * w;
+                    let c = b.rng.random_range(0.35..0.6) * h;
+                    b.floor.push((p(0.0, 0.0), p(w, h - c)));
+                    b.floor.push((p(0.0, h - c), p(w - a, h)));
+                    vec![
+                        p(0.0, 0.0),
+                        p(w, 0.0),
+                        p(w, h - c),
+                        p(w - a, h - c),
+                        p(w - a, h),
+                        p(0.0, h),
+                    ]
+                };
+                let door = b.rng.random_bool(cfg.door_chance).then(|| {
+                    let width = b.rng.random_range(0.7..1.2f32);
+                    // A doorway on an edge long enough for it.
+                    let n = outline.len();
+                    let mut e = b.rng.random_range(0..n);
+                    for _ in 0..n {
+                        if outline[e].distance(outline[(e + 1) % n]) >= width + 0.8 {
+                            break;
+                        }
+                        e = (e + 1) % n;
+                    }
+                    (e, width)
+                });
+                if let Some((c, dir, out)) = b.outline(&outline, door) {
+                    b.hallway(c, dir, out);
+                }
+            }
+            RoomKind::TwoRooms => {
+                let w1 = b.rng.random_range(3.0..6.0f32);
+                let h1 = b.rng.random_range(3.0..6.0f32);
+                let w2 = b.rng.random_range(3.0..6.0f32);
+                let h2 = b.rng.random_range(3.0..6.0f32);
+                let len = b.rng.random_range(1.5..4.0f32);
+                let cw = b.rng.random_range(1.1..1.6f32);
+                let yc = b.rng.random_range(0.3..(h1.min(h2) - cw - 0.3));
+                let yb = 0.0;
+                let x2 = w1 + len;
+                b.floor.push((p(0.0, 0.0), p(w1, h1)));
+                b.floor.push((p(x2, yb), p(x2 + w2, yb + h2)));
+                let outline = vec![
+                    p(0.0, 0.0),
+                    p(w1, 0.0),
+                    p(w1, yc),
+                    p(x2, yc),
+                    p(x2, yb),
+                    p(x2 + w2, yb),
+                    p(x2 + w2, yb + h2),
+                    p(x2, yb + h2),
+                    p(x2, yc + cw),
+                    p(w1, yc + cw),
+                    p(w1, h1),
+                    p(0.0, h1),
+                ];
+                b.outline(&outline, None);
+                // Doorways: walls across the corridor at both ends, each with a gap.
+                for x in [w1, x2 - WALL_T] {
+                    let width = b.rng.random_range(0.7..(cw - 0.2).min(1.2));
+                    let g0 = b.rng.random_range(0.05..(cw - width - 0.05));
+                    b.wall(p(x, yc), p(x, yc + cw), p(1.0, 0.0), Some((g0, g0 + width)));
+                }
             }
         }
+        let area: f32 = b.floor.iter().map(|(a, c)| (c.x - a.x) * (c.y - a.y)).sum();
+        let n = ((area * cfg.furniture_density).round() as usize).max(2);
+        // The first three tries are one of each class, then random; a piece that does not fit
+        // anywhere (a desk in a narrow arm) is replaced by another draw.
+        for i in 0..n + 12 {
+            if b.objects.len() >= n {
+                break;
+            }
+            let class = match (i, b.rng.random_range(0..3)) {
+                (0, _) => ObjectClass::Chair,
+                (1, _) => ObjectClass::Box,
+                (2, _) => ObjectClass::Desk,
+                (_, 0) => ObjectClass::Chair,
+                (_, 1) => ObjectClass::Box,
+                _ => ObjectClass::Desk,
+            };
+            b.furniture(class);
+        }
+        let n_clutter = b.rng.random_range(0..=cfg.max_clutter);
+        for _ in 0..n_clutter {
+            b.clutter_item();
+        }
+        let grid = Grid::build(&b.prims);
+        let mut world = World {
+            kind,
+            prims: b.prims,
+            objects: b.objects,
+            doors: b.doors,
+            clutter: b.clutter,
+            floor: b.floor,
+            robot_start: Point2::default(),
+            grid,
+        };
+        let mut rng = ChaCha8Rng::seed_from_u64(seed ^ 0x0b07);
+        world.robot_start = world.free_point(&mut rng, 0.6).unwrap_or_else(|| {
+            let (lo, hi) = world.floor[0];
+            Point2::new((lo.x + hi.x) / 2.0, (lo.y + hi.y) / 2.0)
+        });
         world
     }
 
-    fn add_box(&mut self, c: Point2, half: f32) {
-        let p = [
-            Point2::new(c.x - half, c.y - half),
-            Point2::new(c.x + half, c.y - half),
-            Point2::new(c.x + half, c.y + half),
-            Point2::new(c.x - half, c.y + half),
-        ];
-        for i in 0..4 {
-            self.segments.push(Segment {
-                a: p[i],
-                b: p[(i + 1) % 4],
-            });
+    /// The study-like default: a random room of any kind.
+    pub fn random_room(seed: u64) -> World {
+        World::generate(seed, &WorldConfig::default())
+    }
+
+    /// One line for people: layout, size, what is in it.
+    pub fn describe(&self) -> String {
+        let (mut lo, mut hi) = (
+            Point2::new(f32::MAX, f32::MAX),
+            Point2::new(f32::MIN, f32::MIN),
+        );
+        for (a, b) in &self.floor {
+            lo = Point2::new(lo.x.min(a.x), lo.y.min(a.y));
+            hi = Point2::new(hi.x.max(b.x), hi.y.max(b.y));
         }
-        self.boxes.push((c, half));
+        let name = match self.kind {
+            RoomKind::Rect => "rectangular room",
+            RoomKind::LShape => "L-shaped room",
+            RoomKind::TwoRooms => "two rooms and a corridor",
+        };
+        format!(
+            "{name} {:.1} × {:.1} m, {} pieces of furniture, {} doorway(s), {} clutter",
+            hi.x - lo.x,
+            hi.y - lo.y,
+            self.objects.len(),
+            self.doors.len(),
+            self.clutter.len()
+        )
     }
 
-    /// Distance from `origin` along the unit direction at `angle` (world frame, radians) to the
-    /// nearest surface, or `None` if nothing is hit.
-    pub fn raycast(&self, origin: Point2, angle: f32) -> Option<f32> {
-        let d = Point2::new(angle.cos(), angle.sin());
-        self.segments
+    /// Distance from `p` to the nearest surface.
+    pub fn clearance(&self, p: Point2) -> f32 {
+        self.prims
             .iter()
-            .filter_map(|s| ray_segment(origin, d, s))
-            .min_by(f32::total_cmp)
+            .map(|pr| pr.shape.distance(p))
+            .fold(f32::INFINITY, f32::min)
     }
-}
 
-/// Ray (origin, unit direction) against a segment: the distance along the ray, if it hits.
-fn ray_segment(o: Point2, d: Point2, s: &Segment) -> Option<f32> {
-    let e = s.b - s.a;
-    let denom = d.x * e.y - d.y * e.x;
-    if denom.abs() < 1e-9 {
-        return None;
+    /// `true` if `p` lies on the floor.
+    pub fn on_floor(&self, p: Point2) -> bool {
+        self.floor
+            .iter()
+            .any(|(lo, hi)| p.x > lo.x && p.x < hi.x && p.y > lo.y && p.y < hi.y)
     }
-    let w = s.a - o;
-    let t = (w.x * e.y - w.y * e.x) / denom;
-    let u = (w.x * d.y - w.y * d.x) / denom;
-    (t > 1e-6 && (0.0..=1.0).contains(&u)).then_some(t)
+
+    /// A random floor point with at least `clearance` to every surface.
+    pub fn free_point(&self, rng: &mut impl Rng, clearance: f32) -> Option<Point2> {
+        let total: f32 = self
+            .floor
+            .iter()
+            .map(|(a, b)| (b.x - a.x) * (b.y - a.y))
+            .sum();
+        for _ in 0..500 {
+            let mut pick = rng.random_range(0.0..total);
+            for (lo, hi) in &self.floor {
+                let area = (hi.x - lo.x) * (hi.y - lo.y);
+                if pick < area {
+                    let p = Point2::new(rng.random_range(lo.x..hi.x), rng.random_range(lo.y..hi.y));
+                    if self.clearance(p) >= clearance {
+                        return Some(p);
+                    }
+                    break;
+                }
+                pick -= area;
+            }
+        }
+        None
+    }
+
+    /// `true` if the straight path from `a` to `b` keeps `clearance` everywhere (sampled every
+    /// 5 cm) and stays on the floor or in doorways.
+    pub fn path_clear(&self, a: Point2, b: Point2, clearance: f32) -> bool {
+        let n = (a.distance(b) / 0.05).ceil().max(1.0) as usize;
+        (0..=n).all(|i| {
+            let t = i as f32 / n as f32;
+            let p = Point2::new(a.x + (b.x - a.x) * t, a.y + (b.y - a.y) * t);
+            self.clearance(p) >= clearance
+        })
+    }
+
+    /// Nearest surface along the ray from `origin` at `angle` (world frame, radians), up to
+    /// `max_range`: (distance, primitive index, cosine of incidence).
+    #[inline]
+    pub fn raycast(&self, origin: Point2, angle: f32, max_range: f32) -> Option<(f32, usize, f32)> {
+        let (s, c) = angle.sin_cos();
+        self.grid
+            .raycast(&self.prims, origin, Point2::new(c, s), max_range)
+    }
+
+    /// Brute-force ray cast over every primitive (the reference for the grid's tests).
+    pub fn raycast_brute(
+        &self,
+        origin: Point2,
+        angle: f32,
+        max_range: f32,
+    ) -> Option<(f32, usize, f32)> {
+        let (s, c) = angle.sin_cos();
+        let d = Point2::new(c, s);
+        self.prims
+            .iter()
+            .enumerate()
+            .filter_map(|(i, p)| p.shape.intersect(origin, d).map(|(t, cos)| (t, i, cos)))
+            .filter(|(t, ..)| *t <= max_range)
+            .min_by(|a, b| a.0.total_cmp(&b.0))
+    }
 }
 
 #[cfg(test)]
@@ -120,19 +796,78 @@ mod test {
     fn seeded_and_reproducible() {
         let a = World::random_room(7);
         let b = World::random_room(7);
-        assert_eq!(a.segments, b.segments);
-        assert_ne!(a.segments, World::random_room(8).segments);
-        assert!(a.boxes.len() >= 2);
+        assert_eq!(a.prims, b.prims);
+        assert_eq!(a.objects, b.objects);
+        assert_ne!(a.prims, World::random_room(8).prims);
     }
 
     #[test]
-    fn ray_hits_walls_of_empty_room() {
-        let mut w = World::random_room(1);
-        w.segments.truncate(4);
-        let (sx, sy) = w.size;
-        let o = Point2::new(1.0, 1.0);
-        assert!((w.raycast(o, 0.0).unwrap() - (sx - 1.0)).abs() < 1e-4);
-        assert!((w.raycast(o, core::f32::consts::FRAC_PI_2).unwrap() - (sy - 1.0)).abs() < 1e-4);
-        assert!((w.raycast(o, core::f32::consts::PI).unwrap() - 1.0).abs() < 1e-4);
+    fn all_kinds_generate_with_furniture_and_clear_start() {
+        for kind in [RoomKind::Rect, RoomKind::LShape, RoomKind::TwoRooms] {
+            let cfg = WorldConfig {
+                kinds: vec![kind],
+                ..WorldConfig::default()
+            };
+            for seed in 0..20 {
+                let w = World::generate(seed, &cfg);
+                assert_eq!(w.kind, kind);
+                assert!(
+                    w.objects.len() >= 2,
+                    "{kind:?} seed {seed}: {} objects",
+                    w.objects.len()
+                );
+                assert!(w.on_floor(w.robot_start));
+                assert!(w.clearance(w.robot_start) >= 0.5, "{kind:?} seed {seed}");
+                if kind == RoomKind::TwoRooms {
+                    assert_eq!(w.doors.len(), 2);
+                }
+                // No two footprints closer than the clearance (bounding circles).
+                for (i, a) in w.objects.iter().enumerate() {
+                    for b in &w.objects[i + 1..] {
+                        let ra = a.centre.distance(a.footprint[0]);
+                        let rb = b.centre.distance(b.footprint[0]);
+                        assert!(a.centre.distance(b.centre) >= ra + rb + CLEARANCE - 1e-3);
+                    }
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn grid_raycast_equals_brute_force() {
+        let mut rng = ChaCha8Rng::seed_from_u64(1);
+        for seed in 0..15 {
+            let w = World::random_room(seed);
+            for _ in 0..400 {
+                let o = w.free_point(&mut rng, 0.2).unwrap();
+                let a = rng.random_range(-4.0..4.0f32);
+                let g = w.raycast(o, a, 6.0);
+                let b = w.raycast_brute(o, a, 6.0);
+                match (g, b) {
+                    (Some(g), Some(b)) => assert!((g.0 - b.0).abs() < 1e-4, "{g:?} vs {b:?}"),
+                    (None, None) => {}
+                    other => panic!("seed {seed}: grid and brute force disagree: {other:?}"),
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn circle_and_segment_hits() {
+        let o = Point2::new(0.0, 0.0);
+        let d = Point2::new(1.0, 0.0);
+        let c = Shape::Circle {
+            c: Point2::new(2.0, 0.0),
+            r: 0.5,
+        };
+        let (t, cos) = c.intersect(o, d).unwrap();
+        assert!((t - 1.5).abs() < 1e-5 && (cos - 1.0).abs() < 1e-5);
+        let s = Shape::Segment {
+            a: Point2::new(3.0, -1.0),
+            b: Point2::new(3.0, 1.0),
+        };
+        let (t, cos) = s.intersect(o, d).unwrap();
+        assert!((t - 3.0).abs() < 1e-5 && (cos - 1.0).abs() < 1e-5);
+        assert!(s.intersect(o, Point2::new(-1.0, 0.0)).is_none());
     }
 }
