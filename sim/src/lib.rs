@@ -21,8 +21,11 @@
 
 pub mod compass;
 pub mod corrupt;
+pub mod dataset;
 pub mod grid;
+pub mod labels;
 pub mod lds01;
+pub mod picture;
 pub mod robot;
 pub mod scenario;
 pub mod world;

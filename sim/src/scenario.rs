@@ -135,6 +135,7 @@ pub struct Scenario {
     /// The compass.
     pub compass: Compass,
     lidar: LidarModel,
+    start_pose: Pose2,
     odom_period: f64,
     next_odom: f64,
     seq: u32,
@@ -155,6 +156,7 @@ impl Scenario {
         let compass = Compass::new(&world, cfg.compass, seeds.random());
         let lidar = LidarModel::new(cfg.lidar.clone(), seeds.random());
         Scenario {
+            start_pose: robot.pose,
             world,
             robot,
             compass,
@@ -167,6 +169,11 @@ impl Scenario {
             next_odom: 0.0,
             seq: 0,
         }
+    }
+
+    /// The robot's pose at the start: the map frame of the output line.
+    pub fn robot_start_pose(&self) -> Pose2 {
+        self.start_pose
     }
 
     /// Simulates the next revolution into `frame`, appending the encoder/compass samples that

@@ -1,16 +1,23 @@
-//! `umbra-sim`: writes simulator output to files.
+//! `umbra-sim`: the simulator's command line.
 //!
-//! `umbra-sim capture --out FILE [--revolutions N] [--seed S] [--room-seed R] [--corrupt]`
-//! writes raw LDS-01 bytes exactly as a serial port would deliver them, which `umbra replay`
-//! reads back.
+//! * `umbra-sim dataset --out DIR [--scenarios 50] [--frames 200] [--seed 1] [--kinds rect,lshape,tworooms]`
+//!   writes the datasets of `sim::dataset` with a progress bar.
+//! * `umbra-sim speed [--scenarios 16] [--frames 200]` measures labelled frames per second
+//!   with rasters and labels built in memory.
+//! * `umbra-sim capture --out FILE [--revolutions N] [--seed S] [--corrupt]` writes raw LDS-01
+//!   bytes as a serial port delivers them (for `umbra replay`).
+//! * `umbra-sim picture --out FILE [--seed S] [--tour]` draws a scene.
 
 use std::path::PathBuf;
 use std::process::ExitCode;
+use std::time::Instant;
 
-use clap::{Parser, Subcommand};
+use clap::{Parser, Subcommand, ValueEnum};
+use indicatif::{ProgressBar, ProgressStyle};
 use sim::corrupt::{Corruption, corrupt};
+use sim::dataset::{DatasetConfig, generate, in_memory, simulate};
 use sim::lds01::{Lds01Sim, Lds01SimConfig};
-use sim::world::World;
+use sim::world::{RoomKind, World, WorldConfig};
 
 #[derive(Parser)]
 #[command(
@@ -23,8 +30,60 @@ struct Cli {
     command: Command,
 }
 
+#[derive(Clone, Copy, ValueEnum)]
+enum Kind {
+    Rect,
+    Lshape,
+    Tworooms,
+}
+
 #[derive(Subcommand)]
 enum Command {
+    /// Write a dataset (Method B YOLO layout, Method A labels, recordings, pictures).
+    Dataset {
+        /// Output folder.
+        #[arg(long)]
+        out: PathBuf,
+        /// Scenarios.
+        #[arg(long, default_value_t = 50)]
+        scenarios: usize,
+        /// Labelled frames per scenario.
+        #[arg(long, default_value_t = 200)]
+        frames: usize,
+        /// Master seed.
+        #[arg(long, default_value_t = 1)]
+        seed: u64,
+        /// Room layouts to draw from.
+        #[arg(long, value_enum, value_delimiter = ',', default_values_t = [Kind::Rect, Kind::Lshape, Kind::Tworooms])]
+        kinds: Vec<Kind>,
+        /// Most clutter items per scene.
+        #[arg(long, default_value_t = 3)]
+        clutter: usize,
+        /// Skip Method B images and labels.
+        #[arg(long)]
+        no_images: bool,
+        /// Skip Method A labels.
+        #[arg(long)]
+        no_method_a: bool,
+        /// Skip recordings.
+        #[arg(long)]
+        no_recordings: bool,
+        /// Pictures of the first N scenarios.
+        #[arg(long, default_value_t = 3)]
+        pictures: usize,
+    },
+    /// Labelled frames per second, rasters and labels in memory.
+    Speed {
+        /// Scenarios.
+        #[arg(long, default_value_t = 16)]
+        scenarios: usize,
+        /// Labelled frames per scenario.
+        #[arg(long, default_value_t = 200)]
+        frames: usize,
+        /// Master seed.
+        #[arg(long, default_value_t = 1)]
+        seed: u64,
+    },
     /// Write a raw LDS-01 capture of a simulated robot in a random room.
     Capture {
         /// Output file.
@@ -43,11 +102,119 @@ enum Command {
         #[arg(long)]
         corrupt: bool,
     },
+    /// Draw one scenario of a dataset seed as a PNG.
+    Picture {
+        /// Output PNG.
+        #[arg(long)]
+        out: PathBuf,
+        /// Master seed.
+        #[arg(long, default_value_t = 1)]
+        seed: u64,
+        /// Scenario index (odd indices drive waypoint tours).
+        #[arg(long, default_value_t = 1)]
+        scenario: usize,
+        /// Frames to simulate (the path drawn; the last revolution's returns are shown).
+        #[arg(long, default_value_t = 300)]
+        frames: usize,
+    },
+}
+
+fn kinds(k: &[Kind]) -> Vec<RoomKind> {
+    k.iter()
+        .map(|k| match k {
+            Kind::Rect => RoomKind::Rect,
+            Kind::Lshape => RoomKind::LShape,
+            Kind::Tworooms => RoomKind::TwoRooms,
+        })
+        .collect()
 }
 
 fn main() -> ExitCode {
-    let cli = Cli::parse();
-    match cli.command {
+    match run(Cli::parse().command) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("umbra-sim: {e}");
+            ExitCode::from(1)
+        }
+    }
+}
+
+fn run(command: Command) -> Result<(), String> {
+    match command {
+        Command::Dataset {
+            out,
+            scenarios,
+            frames,
+            seed,
+            kinds: k,
+            clutter,
+            no_images,
+            no_method_a,
+            no_recordings,
+            pictures,
+        } => {
+            let cfg = DatasetConfig {
+                scenarios,
+                frames,
+                seed,
+                world: WorldConfig {
+                    kinds: kinds(&k),
+                    max_clutter: clutter,
+                    ..WorldConfig::default()
+                },
+                method_b: !no_images,
+                method_a: !no_method_a,
+                recordings: !no_recordings,
+                pictures,
+                ..DatasetConfig::default()
+            };
+            let bar = ProgressBar::new((scenarios * frames) as u64);
+            bar.set_style(
+                ProgressStyle::with_template(
+                    "{elapsed_precise} [{bar:40}] {pos}/{len} frames ({per_sec}, eta {eta})",
+                )
+                .map_err(|e| e.to_string())?,
+            );
+            let report = generate(&cfg, &out, |n| bar.inc(n))?;
+            bar.finish();
+            println!(
+                "wrote {} labelled frames from {scenarios} scenarios to {} in {:.1} s ({:.0} frames/s); no-return share {:.1} %",
+                report.frames,
+                out.display(),
+                report.seconds,
+                report.frames as f64 / report.seconds,
+                report.no_return_share * 100.0
+            );
+            for (si, name) in ["train", "val", "test"].iter().enumerate() {
+                let b = report.boxes[si];
+                println!(
+                    "  {name:5}: {:6} frames, boxes chair {} box {} desk {} door_frame {}",
+                    report.frames_per_split[si], b[0], b[1], b[2], b[3]
+                );
+            }
+            Ok(())
+        }
+        Command::Speed {
+            scenarios,
+            frames,
+            seed,
+        } => {
+            let cfg = DatasetConfig {
+                scenarios,
+                frames,
+                seed,
+                ..DatasetConfig::default()
+            };
+            let start = Instant::now();
+            let (n, digest) = in_memory(&cfg);
+            let s = start.elapsed().as_secs_f64();
+            println!(
+                "{n} labelled frames in {s:.2} s: {:.0} frames/s on {} threads (digest {digest:016x})",
+                n as f64 / s,
+                rayon::current_num_threads()
+            );
+            Ok(())
+        }
         Command::Capture {
             out,
             revolutions,
@@ -65,16 +232,50 @@ fn main() -> ExitCode {
             if noisy {
                 bytes = corrupt(bytes.chunks(42), Corruption::ISSUE_MIX, seed).bytes;
             }
-            if let Err(e) = std::fs::write(&out, &bytes) {
-                eprintln!("umbra-sim: cannot write {}: {e}", out.display());
-                return ExitCode::from(1);
-            }
+            std::fs::write(&out, &bytes)
+                .map_err(|e| format!("cannot write {}: {e}", out.display()))?;
             println!(
                 "wrote {} bytes ({revolutions} revolutions) to {}",
                 bytes.len(),
                 out.display()
             );
-            ExitCode::SUCCESS
+            Ok(())
+        }
+        Command::Picture {
+            out,
+            seed,
+            scenario,
+            frames,
+        } => {
+            let cfg = DatasetConfig {
+                frames,
+                seed,
+                ..DatasetConfig::default()
+            };
+            let mut path = Vec::new();
+            let mut last = None;
+            let sc = simulate(
+                scenario,
+                &cfg,
+                |_, f, _| {
+                    path.push(perception::geometry::Point2::new(
+                        f.pose_mid.x,
+                        f.pose_mid.y,
+                    ))
+                },
+                |_, s| last = Some(s.frame.clone()),
+            );
+            let file =
+                std::fs::File::create(&out).map_err(|e| format!("{}: {e}", out.display()))?;
+            sim::picture::write_png(
+                &sc.world,
+                &path,
+                last.as_ref(),
+                std::io::BufWriter::new(file),
+            )
+            .map_err(|e| format!("{}: {e}", out.display()))?;
+            println!("{}: {}", out.display(), sc.world.describe());
+            Ok(())
         }
     }
 }
