@@ -2,8 +2,9 @@
 //! class with its footprint, clutter, the robot's path, and one revolution's returns.
 //!
 //! Colours: walls black; door frames orange; chairs blue, boxes brown, desks green (footprints
-//! outlined, legs filled); clutter grey; robot path red; LiDAR returns magenta; robot start a
-//! red disc. 100 px per metre.
+//! outlined, legs filled); clutter grey; robot path red; robot start a red disc; the robot
+//! during the revolution shown a purple disc, that revolution's returns magenta. 100 px per
+//! metre.
 
 use std::io::Write;
 
@@ -156,6 +157,11 @@ pub fn write_png(
         cv.line(s[0], s[1], [220, 30, 30], 2);
     }
     if let Some(f) = frame {
+        cv.disc(
+            Point2::new(f.pose_mid.x, f.pose_mid.y),
+            0.105,
+            [120, 0, 110],
+        );
         let lidar = f.pose_mid.compose(&LIDAR_MOUNT);
         for (d, r) in f.readings.iter().enumerate() {
             if r.raw.range_mm > 0 {

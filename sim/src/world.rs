@@ -548,6 +548,14 @@ impl Builder {
     }
 }
 
+/// `true` if `p` is inside the convex quadrilateral `q` (counter-clockwise).
+fn inside(q: &[Point2; 4], p: Point2) -> bool {
+    (0..4).all(|i| {
+        let (a, b) = (q[i], q[(i + 1) % 4]);
+        (b.x - a.x) * (p.y - a.y) - (b.y - a.y) * (p.x - a.x) >= 0.0
+    })
+}
+
 impl World {
     /// A random world from `seed`.
     pub fn generate(seed: u64, cfg: &WorldConfig) -> World {
@@ -711,12 +719,29 @@ impl World {
         )
     }
 
-    /// Distance from `p` to the nearest surface.
+    /// Distance from `p` to the nearest surface or furniture footprint (0 inside one: the
+    /// robot does not drive under desks or between a chair's legs).
     pub fn clearance(&self, p: Point2) -> f32 {
-        self.prims
+        let surfaces = self
+            .prims
             .iter()
             .map(|pr| pr.shape.distance(p))
-            .fold(f32::INFINITY, f32::min)
+            .fold(f32::INFINITY, f32::min);
+        self.objects.iter().fold(surfaces, |best, o| {
+            let fp = &o.footprint;
+            if inside(fp, p) {
+                return 0.0;
+            }
+            (0..4)
+                .map(|i| {
+                    Shape::Segment {
+                        a: fp[i],
+                        b: fp[(i + 1) % 4],
+                    }
+                    .distance(p)
+                })
+                .fold(best, f32::min)
+        })
     }
 
     /// `true` if `p` lies on the floor.
