@@ -8,6 +8,7 @@
 //! | module      | owns                                                          | needs  |
 //! |-------------|---------------------------------------------------------------|--------|
 //! | [`lds01`]   | LDS-01 packets, streaming decoder, revolution assembler        | core   |
+//! | [`dynamixel`] | DYNAMIXEL Protocol 2.0 (OpenCR): CRC-16, stuffing, instruction emit, status decoder | core |
 //! | `serial`    | serial ports via `serialport`, as `embedded-io`; reopen with back-off | `std`  |
 //!
 //! ## Guarantees
@@ -26,6 +27,7 @@
 #![cfg_attr(not(any(test, feature = "std")), no_std)]
 #![deny(unsafe_code, missing_docs)]
 
+pub mod dynamixel;
 pub mod lds01;
 #[cfg(feature = "std")]
 pub mod serial;

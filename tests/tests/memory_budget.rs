@@ -5,6 +5,7 @@
 use std::collections::BTreeMap;
 use std::mem::size_of;
 
+use drivers::dynamixel::{MAX_PACKET_LEN, StatusDecoder};
 use drivers::lds01::assembler::ASSEMBLER_REVOLUTIONS;
 use drivers::lds01::decoder::DECODER_BUFFER_LEN;
 use drivers::lds01::{Lds01Stream, READINGS_PER_REV, Reading, Revolution};
@@ -34,6 +35,12 @@ fn buffers_in_code() -> Vec<(&'static str, usize, usize)> {
             size_of::<Lds01Stream>(),
         ),
         ("firmware::runner::READ_CHUNK", READ_CHUNK, 1),
+        ("drivers::dynamixel::MAX_PACKET_LEN", MAX_PACKET_LEN, 1),
+        (
+            "size_of::<drivers::dynamixel::StatusDecoder>()",
+            1,
+            size_of::<StatusDecoder>(),
+        ),
     ]
 }
 
