@@ -232,9 +232,7 @@ impl StatusDecoder {
             // then the whole packet.
             let mut rescan = false;
             while self.len < need {
-                let Some((&b, rest)) = input.split_first() else {
-                    return None;
-                };
+                let (&b, rest) = input.split_first()?;
                 *input = rest;
                 self.stats.bytes_in += 1;
                 self.buf[self.len] = b;
