@@ -8,6 +8,7 @@
 //! |----------------|--------------------------------------------------------------|
 //! | [`geometry`]   | 2D points and rigid poses in REP 103 (x forward, y left, CCW) |
 //! | [`class`]      | the object classes both methods report, with their wire names |
+//! | [`pose`]       | wheel odometry, hard-iron fit, compass/odometry heading filter |
 //! | [`raster`]     | three revolutions as the 64 × 384 × 3 image of Method B (bit-exact spec) |
 //!
 //! The global point cloud, DBSCAN, walls and doors, features and YOLO decoding
@@ -17,4 +18,5 @@
 
 pub mod class;
 pub mod geometry;
+pub mod pose;
 pub mod raster;

@@ -16,6 +16,7 @@
 //! | [`labels`]    | Method B boxes from footprints, per-reading labels                    |
 //! | [`dataset`]   | dataset writers: YOLO layout, Method A labels, replay recordings      |
 //! | [`picture`]   | a PNG of a scene for people to look at                                |
+//! | [`pose_eval`] | drift of odometry, compass overwrite and our fusion on the simulator   |
 //! | [`corrupt`]   | a noisy serial line: bit flips, inserted and dropped bytes, with truth |
 #![deny(unsafe_code, missing_docs)]
 
@@ -26,6 +27,7 @@ pub mod grid;
 pub mod labels;
 pub mod lds01;
 pub mod picture;
+pub mod pose_eval;
 pub mod robot;
 pub mod scenario;
 pub mod world;

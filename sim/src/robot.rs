@@ -33,6 +33,11 @@ pub enum Motion {
         /// Period, s.
         period_s: f32,
     },
+    /// Turning in place at a constant rate (compass calibration).
+    Spin {
+        /// Angular speed, rad/s.
+        rate_rad_s: f32,
+    },
     /// A tour of random waypoints with clearance, driven turn-then-go at `speed_m_s`.
     Tour {
         /// Cruise speed, m/s.
@@ -45,9 +50,15 @@ pub enum Motion {
 pub struct RobotConfig {
     /// The motion script.
     pub motion: Motion,
-    /// Standard deviation of the per-step slip fraction.
+    /// Standard deviation of the slip fraction (a per-wheel process correlated over
+    /// [`SLIP_TAU_S`], as on a real floor: a patch of carpet, a turn on a smooth tile).
     pub slip_sigma: f32,
 }
+
+/// Correlation time of the slip process, s.
+pub const SLIP_TAU_S: f32 = 1.0;
+/// Largest per-wheel systematic travel error (effective radius vs nominal), fraction.
+pub const SLIP_BIAS_MAX: f32 = 0.003;
 
 impl Default for RobotConfig {
     fn default() -> Self {
@@ -73,6 +84,9 @@ pub struct Robot {
     waypoints: Vec<Point2>,
     next_wp: usize,
     rng: ChaCha8Rng,
+    /// Per-wheel slip: systematic part and correlated random part.
+    slip_bias: [f32; 2],
+    slip_state: [f32; 2],
 }
 
 impl Robot {
@@ -108,6 +122,15 @@ impl Robot {
             t: 0.0,
             waypoints,
             next_wp: 0,
+            slip_bias: if cfg.slip_sigma > 0.0 {
+                [
+                    rng.random_range(-SLIP_BIAS_MAX..SLIP_BIAS_MAX),
+                    rng.random_range(-SLIP_BIAS_MAX..SLIP_BIAS_MAX),
+                ]
+            } else {
+                [0.0; 2]
+            },
+            slip_state: [0.0; 2],
             rng,
         }
     }
@@ -139,6 +162,7 @@ impl Robot {
                 let phase = core::f64::consts::TAU * self.t / f64::from(period_s);
                 (0.0, amplitude_rad_s * phase.sin() as f32)
             }
+            Motion::Spin { rate_rad_s } => (0.0, rate_rad_s),
             Motion::Tour { speed_m_s } => {
                 let Some(&target) = self.waypoints.get(self.next_wp) else {
                     return (0.0, 0.0);
@@ -170,13 +194,18 @@ impl Robot {
         let (dl, dr) = (wl * dt, wr * dt);
         self.wheel_rad[0] += f64::from(dl);
         self.wheel_rad[1] += f64::from(dr);
-        // Ground travel with slip.
-        let mut slip = || {
-            let g: f32 = (0..3).map(|_| self.rng.random_range(-1.0..1.0f32)).sum();
-            1.0 - g * self.cfg.slip_sigma
-        };
-        let sl = dl * WHEEL_RADIUS * slip();
-        let sr = dr * WHEEL_RADIUS * slip();
+        // Ground travel with slip: an Ornstein–Uhlenbeck process per wheel plus its bias.
+        let a = (dt / SLIP_TAU_S).min(1.0);
+        let kick = self.cfg.slip_sigma * (2.0 * a).sqrt();
+        for w in 0..2 {
+            let g: f32 = (0..3)
+                .map(|_| self.rng.random_range(-1.0..1.0f32))
+                .sum::<f32>()
+                * 0.577;
+            self.slip_state[w] += -self.slip_state[w] * a + kick * g;
+        }
+        let sl = dl * WHEEL_RADIUS * (1.0 - self.slip_bias[0] - self.slip_state[0]);
+        let sr = dr * WHEEL_RADIUS * (1.0 - self.slip_bias[1] - self.slip_state[1]);
         let ds = (sl + sr) / 2.0;
         let dth = (sr - sl) / WHEEL_SEPARATION;
         let th = self.pose.theta;
