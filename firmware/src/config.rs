@@ -10,12 +10,23 @@
 //!
 //! [runtime]
 //! deadline_ms = 250        # per-frame budget
+//!
+//! [odometry]               # TurtleBot3 Burger defaults
+//! wheel_radius_m = 0.033
+//! wheel_separation_m = 0.160
+//! ticks_per_rev = 4096
+//!
+//! [compass]
+//! hard_iron_ut = [12.0, -3.5]  # from `umbra calibrate-compass`; absent: compass not used
+//! offset_deg = 0.0             # magnetic declination + mount offset
+//! field_tolerance = 0.08       # accepted deviation of the horizontal field strength
 //! ```
 
 use std::fmt;
 use std::path::{Path, PathBuf};
 
 use drivers::lds01::{AssemblerConfig, ChecksumPolicy, Lds01Config};
+use perception::pose::{HeadingConfig, OdometryConfig, PoseFilter};
 use serde::Deserialize;
 
 /// Checksum policy as written in the file.
@@ -69,6 +80,51 @@ impl Default for RuntimeSettings {
     }
 }
 
+/// `[odometry]`.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct OdometrySettings {
+    /// Wheel radius, m.
+    pub wheel_radius_m: f32,
+    /// Wheel separation, m.
+    pub wheel_separation_m: f32,
+    /// Encoder ticks per wheel turn.
+    pub ticks_per_rev: f32,
+}
+
+impl Default for OdometrySettings {
+    fn default() -> Self {
+        let b = OdometryConfig::BURGER;
+        OdometrySettings {
+            wheel_radius_m: b.wheel_radius_m,
+            wheel_separation_m: b.wheel_separation_m,
+            ticks_per_rev: b.ticks_per_rev,
+        }
+    }
+}
+
+/// `[compass]`.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct CompassSettings {
+    /// Hard-iron offset (x, y), µT; `None`: the compass is not used.
+    pub hard_iron_ut: Option<[f32; 2]>,
+    /// Declination plus mount offset, degrees.
+    pub offset_deg: f32,
+    /// Accepted deviation of the horizontal field strength, fraction.
+    pub field_tolerance: f32,
+}
+
+impl Default for CompassSettings {
+    fn default() -> Self {
+        CompassSettings {
+            hard_iron_ut: None,
+            offset_deg: 0.0,
+            field_tolerance: HeadingConfig::default().field_tolerance,
+        }
+    }
+}
+
 /// The whole configuration.
 #[derive(Debug, Clone, PartialEq, Deserialize, Default)]
 #[serde(default, deny_unknown_fields)]
@@ -77,6 +133,10 @@ pub struct Config {
     pub lidar: LidarSettings,
     /// Loop settings.
     pub runtime: RuntimeSettings,
+    /// Wheel geometry.
+    pub odometry: OdometrySettings,
+    /// Compass calibration and gates.
+    pub compass: CompassSettings,
 }
 
 /// A configuration error, naming the file and field.
@@ -138,6 +198,23 @@ impl Config {
             ));
         }
         Ok(())
+    }
+
+    /// A pose filter with these settings; the hard-iron offset given overrides the file's.
+    pub fn pose_filter(&self, hard_iron: Option<[f32; 2]>) -> PoseFilter {
+        let o = &self.odometry;
+        let odo = OdometryConfig {
+            wheel_radius_m: o.wheel_radius_m,
+            wheel_separation_m: o.wheel_separation_m,
+            ticks_per_rev: o.ticks_per_rev,
+        };
+        let heading = HeadingConfig {
+            offset_rad: self.compass.offset_deg.to_radians(),
+            field_tolerance: self.compass.field_tolerance,
+            ..HeadingConfig::default()
+        };
+        let hi = hard_iron.or(self.compass.hard_iron_ut).unwrap_or([0.0; 2]);
+        PoseFilter::new(odo, heading, (hi[0], hi[1]))
     }
 
     /// The LDS-01 driver settings.

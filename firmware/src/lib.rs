@@ -8,11 +8,13 @@
 //! | [`config`]   | the TOML configuration, defaults and validation             |
 //! | [`source`]   | LiDAR byte sources: serial port, capture file, simulated robot |
 //! | [`runner`]   | the frame loop: ingest → output, limits, pacing             |
+//! | [`odom`]     | odometry/compass input (`--odom` JSON Lines, the simulated robot) → pose |
 //! | [`output`]   | the JSON output line (§3) and per-revolution statistics     |
 #![deny(unsafe_code, missing_docs)]
 
 pub mod cli;
 pub mod config;
+pub mod odom;
 pub mod output;
 pub mod runner;
 pub mod source;

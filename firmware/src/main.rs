@@ -10,7 +10,8 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use clap::Parser;
 use firmware::cli::{Cli, Command, Common, LidarModel, Speed};
 use firmware::config::Config;
-use firmware::runner::{self, RunOptions, SecondsClock, Summary};
+use firmware::odom::{OdomFile, PoseState};
+use firmware::runner::{self, PoseInput, RunOptions, SecondsClock, Summary};
 use firmware::source::{LidarSource, Pacing};
 
 /// Exit status for bad arguments or configuration.
@@ -59,19 +60,53 @@ fn dispatch(cli: Cli) -> Result<(), Failure> {
             } else {
                 Pacing::Max // the port paces itself
             };
-            run_loop(&mut source, &cfg, &args.common, pacing, SecondsClock::Wall)
+            let pose = source.is_simulated().then(|| {
+                let hi = source.sim_hard_iron();
+                match hi {
+                    Some(h) => log::info!(
+                        "simulated compass calibrated by a two-turn spin: hard iron ({:.2}, {:.2}) µT",
+                        h[0],
+                        h[1]
+                    ),
+                    None => log::warn!("simulated compass calibration failed: heading from odometry only"),
+                }
+                PoseInput {
+                    state: PoseState::new(cfg.pose_filter(hi), hi.is_some()),
+                    file: None,
+                    queue: Default::default(),
+                }
+            });
+            run_loop(
+                &mut source,
+                &cfg,
+                &args.common,
+                pacing,
+                SecondsClock::Wall,
+                pose,
+            )
         }
         Command::Replay(args) => {
             let cfg = load_config(&args.common)?;
             check_lidar_model(args.common.lidar_model)?;
             let mut source = LidarSource::capture(&args.capture).map_err(|m| (EXIT_USAGE, m))?;
             println!("umbra: {}", source.describe());
-            if let Some(odom) = &args.odom {
-                log::warn!(
-                    "--odom {}: odometry replay has not landed yet; robot assumed still",
-                    odom.display()
-                );
-            }
+            let pose = match &args.odom {
+                Some(path) => {
+                    let file = OdomFile::open(path).map_err(|m| (EXIT_USAGE, m))?;
+                    let use_compass = cfg.compass.hard_iron_ut.is_some();
+                    if !use_compass {
+                        log::warn!(
+                            "no [compass] hard_iron_ut in the configuration: compass readings ignored, heading from odometry only (run `umbra calibrate-compass`)"
+                        );
+                    }
+                    Some(PoseInput {
+                        state: PoseState::new(cfg.pose_filter(None), use_compass),
+                        file: Some(file),
+                        queue: Default::default(),
+                    })
+                }
+                None => None,
+            };
             let pacing = match args.speed {
                 Speed::Max => Pacing::Max,
                 Speed::RealTime => Pacing::RealTime,
@@ -82,6 +117,7 @@ fn dispatch(cli: Cli) -> Result<(), Failure> {
                 &args.common,
                 pacing,
                 SecondsClock::Sensor,
+                pose,
             )
         }
     }
@@ -113,6 +149,7 @@ fn run_loop(
     common: &Common,
     pacing: Pacing,
     seconds_clock: SecondsClock,
+    pose: Option<PoseInput>,
 ) -> Result<(), Failure> {
     if let Some(s) = common.seconds
         && !(s.is_finite() && s > 0.0)
@@ -149,6 +186,7 @@ fn run_loop(
         jsonl,
         stats,
         stop,
+        pose,
     };
     let summary = runner::run(source, cfg.lds01(), opts)
         .map_err(|e| (EXIT_FAULT, format!("cannot write output: {e}")))?;

@@ -65,6 +65,8 @@ pub struct DoorOut {
 pub struct TimingOut {
     /// Reading and decoding the revolution's bytes.
     pub ingest: f64,
+    /// Feeding odometry and compass to the pose filter.
+    pub pose: f64,
     /// Whole frame.
     pub total: f64,
 }
@@ -78,9 +80,9 @@ pub struct FaultsOut {
     pub lidar_bad_checksum: u64,
     /// Packets missing from revolutions.
     pub lidar_missing_packets: u64,
-    /// Wheel-encoder errors (no encoder source yet: always 0).
+    /// Wheel-encoder errors: bad odometry lines or samples.
     pub encoder_errors: u64,
-    /// Compass readings rejected (no compass source yet: always 0).
+    /// Compass readings the pose filter rejected (disturbance).
     pub compass_rejected: u64,
     /// Sync bytes followed by a bad index.
     pub lidar_bad_index: u64,
@@ -200,6 +202,7 @@ mod test {
             doors: vec![],
             timing_ms: TimingOut {
                 ingest: 0.1,
+                pose: 0.0,
                 total: 0.2,
             },
             deadline_ms: 250.0,

@@ -10,7 +10,12 @@ use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
 
+use std::collections::VecDeque;
+
 use drivers::lds01::{Lds01Config, Lds01Faults, Lds01Stream};
+use perception::geometry::Pose2;
+
+use crate::odom::{OdomFile, OdomRecord, PoseState};
 
 use crate::output::{FaultsOut, LidarOut, OutputLine, PoseOut, TimingOut, stats_line};
 use crate::source::{LidarSource, Pacing, SourceRead};
@@ -45,6 +50,39 @@ pub struct RunOptions {
     pub stats: Option<Box<dyn Write>>,
     /// Set from outside (Ctrl-C) to stop cleanly.
     pub stop: Arc<AtomicBool>,
+    /// Pose input; `None`: no odometry, the robot is assumed still.
+    pub pose: Option<PoseInput>,
+}
+
+/// Samples queued from a live source before the frame they belong to, at most (20 Hz encoders
+/// over 2 s; older ones are fed at once rather than dropped).
+pub const ODOM_QUEUE: usize = 40;
+
+/// Where the pose comes from.
+pub struct PoseInput {
+    /// The filter and its fault counters.
+    pub state: PoseState,
+    /// An `--odom` file, read in step with the frames.
+    pub file: Option<OdomFile>,
+    /// Samples from a live source (the simulator), waiting for their frame.
+    pub queue: VecDeque<OdomRecord>,
+}
+
+impl PoseInput {
+    /// Feeds every sample up to sensor time `t` and returns the pose.
+    fn advance(&mut self, t: f64) -> Pose2 {
+        if let Some(f) = self.file.as_mut() {
+            f.advance(t, &mut self.state);
+        }
+        while let Some(r) = self.queue.front().copied() {
+            if r.t > t && self.queue.len() <= ODOM_QUEUE {
+                break;
+            }
+            self.state.feed(&r);
+            self.queue.pop_front();
+        }
+        self.state.filter.pose()
+    }
 }
 
 /// What a run did.
@@ -126,6 +164,9 @@ pub fn run(
             }
         };
         summary.bytes += n as u64;
+        if let Some(p) = opts.pose.as_mut() {
+            source.drain_odometry(&mut p.queue);
+        }
         let mut input = &buf[..n.min(READ_CHUNK)];
         let now = host_us();
         loop {
@@ -185,6 +226,20 @@ fn emit_frame(
     if let Some(w) = opts.stats.as_mut() {
         writeln!(w, "{}", stats_line(frame, rev))?;
     }
+    let t = rev.first_ray_time_s().max(0.0);
+    let t_pose = Instant::now();
+    let (pose, encoder_errors, compass_rejected) = match opts.pose.as_mut() {
+        Some(p) => {
+            let pose = p.advance(t);
+            (
+                pose,
+                p.state.encoder_errors,
+                u64::from(p.state.filter.compass_rejected()),
+            )
+        }
+        None => (Pose2::IDENTITY, 0, 0),
+    };
+    let pose_ms = t_pose.elapsed().as_secs_f64() * 1e3;
     let ingest_ms = ingest.as_secs_f64() * 1e3;
     let total_ms = ingest_ms + t_frame.elapsed().as_secs_f64() * 1e3;
     let missed = total_ms > opts.deadline_ms;
@@ -194,24 +249,33 @@ fn emit_frame(
     if let Some(w) = opts.jsonl.as_mut() {
         let line = OutputLine {
             frame,
-            t: rev.first_ray_time_s().max(0.0),
-            pose: PoseOut::default(),
+            t,
+            pose: PoseOut {
+                x: f64::from(pose.x),
+                y: f64::from(pose.y),
+                theta: f64::from(pose.theta),
+            },
             objects: Vec::new(),
             walls: Vec::new(),
             doors: Vec::new(),
             timing_ms: TimingOut {
                 ingest: ingest_ms,
+                pose: pose_ms,
                 total: total_ms,
             },
             deadline_ms: opts.deadline_ms,
             deadline_missed: missed,
             degraded: false,
             power_w: None,
-            faults: FaultsOut::new(
-                &stream.faults(),
-                summary.invalid_readings,
-                source.link_counts(),
-            ),
+            faults: FaultsOut {
+                encoder_errors,
+                compass_rejected,
+                ..FaultsOut::new(
+                    &stream.faults(),
+                    summary.invalid_readings,
+                    source.link_counts(),
+                )
+            },
             lidar: LidarOut {
                 rpm: f64::from(rev.rpm),
                 packets: rev.packets,

@@ -8,8 +8,10 @@ use drivers::lds01::PACKET_LEN;
 use drivers::serial::{LinkRead, SerialConfig, SerialLink};
 use embedded_io::Read as _;
 use embedded_io_adapters::std::FromStd;
-use sim::lds01::{Lds01Sim, Lds01SimConfig};
-use sim::world::World;
+use sim::lds01::Lds01Sim;
+use sim::scenario::{Scenario, ScenarioConfig};
+
+use crate::odom::OdomRecord;
 
 /// What one read gave.
 #[derive(Debug)]
@@ -52,6 +54,8 @@ pub enum LidarSource {
         sim: Box<Lds01Sim>,
         /// Room seed, for messages.
         room_seed: u64,
+        /// Hard-iron offset fitted by a calibration spin of the simulated compass.
+        hard_iron: Option<[f32; 2]>,
     },
 }
 
@@ -76,15 +80,38 @@ impl LidarSource {
         })
     }
 
-    /// The simulated robot in a seeded random room.
-    pub fn sim(room_seed: u64, noise_seed: u64) -> Self {
+    /// The simulated robot in a seeded random room (the study's oscillation in place), with
+    /// encoders and a compass at 20 Hz; the compass is calibrated by a simulated two-turn spin,
+    /// as `umbra calibrate-compass` would on a robot.
+    pub fn sim(room_seed: u64, _noise_seed: u64) -> Self {
+        let scenario = Scenario::new(room_seed, &ScenarioConfig::standard());
+        let hard_iron = scenario.calibrate_compass().map(|h| [h.x_ut, h.y_ut]);
         LidarSource::Sim {
-            sim: Box::new(Lds01Sim::new(
-                World::random_room(room_seed),
-                Lds01SimConfig::default(),
-                noise_seed,
-            )),
+            sim: Box::new(Lds01Sim::from_scenario(scenario)),
             room_seed,
+            hard_iron,
+        }
+    }
+
+    /// The calibrated hard-iron offset of the simulated compass, if this is the simulator.
+    pub fn sim_hard_iron(&self) -> Option<[f32; 2]> {
+        match self {
+            LidarSource::Sim { hard_iron, .. } => *hard_iron,
+            _ => None,
+        }
+    }
+
+    /// Moves encoder/compass samples the source produced into `out` (the simulator only).
+    pub fn drain_odometry(&mut self, out: &mut std::collections::VecDeque<OdomRecord>) {
+        if let LidarSource::Sim { sim, .. } = self {
+            for o in sim.drain_odometry() {
+                out.push_back(OdomRecord {
+                    t: o.t,
+                    left_ticks: Some(i64::from(o.left_ticks)),
+                    right_ticks: Some(i64::from(o.right_ticks)),
+                    mag_ut: Some(o.mag_ut),
+                });
+            }
         }
     }
 
@@ -93,7 +120,7 @@ impl LidarSource {
         match self {
             LidarSource::Serial(link) => format!("LDS-01 on serial port {}", link.path()),
             LidarSource::Capture { path, .. } => format!("raw LDS-01 capture {}", path.display()),
-            LidarSource::Sim { sim, room_seed } => format!(
+            LidarSource::Sim { sim, room_seed, .. } => format!(
                 "no hardware named: running on the built-in simulated robot (LDS-01; seed {room_seed}: {})",
                 sim.world().describe()
             ),

@@ -285,3 +285,136 @@ fn count_policy_keeps_and_counts_bad_packets() {
     assert!(missing_verify >= bad);
     assert!(missing_count * 2 < missing_verify);
 }
+
+#[test]
+fn replay_with_odometry_follows_the_true_pose() {
+    let dir = tmp("odom-ds");
+    let _ = std::fs::remove_dir_all(&dir);
+    let cfg = sim::dataset::DatasetConfig {
+        scenarios: 2,
+        frames: 40,
+        seed: 5,
+        method_b: false,
+        method_a: false,
+        pictures: 0,
+        ..sim::dataset::DatasetConfig::default()
+    };
+    sim::dataset::generate(&cfg, &dir, |_| {}).unwrap();
+    // Scenario 1 drives a waypoint tour.
+    let rec = dir.join("recordings/s0001");
+    let out = tmp("odom.jsonl");
+    let o = umbra(&[
+        "replay",
+        rec.join("capture.bin").to_str().unwrap(),
+        "--odom",
+        rec.join("odom.jsonl").to_str().unwrap(),
+        "--jsonl",
+        out.to_str().unwrap(),
+        "--quiet",
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let frames: Vec<Value> = std::fs::read_to_string(&out)
+        .unwrap()
+        .lines()
+        .map(|l| serde_json::from_str(l).unwrap())
+        .collect();
+    let truth: Vec<Value> = std::fs::read_to_string(rec.join("truth.jsonl"))
+        .unwrap()
+        .lines()
+        .map(|l| serde_json::from_str(l).unwrap())
+        .collect();
+    assert_eq!(frames.len(), truth.len());
+    let f = |v: &Value| v.as_f64().unwrap();
+    let last = frames.last().unwrap();
+    let last_truth = truth.last().unwrap();
+    let travelled = f(&last_truth["pose"]["x"]).hypot(f(&last_truth["pose"]["y"]));
+    // An independent integration of the same samples (Burger constants, plain arithmetic),
+    // up to each frame's time: the runtime must agree with it to the millimetre.
+    let odom: Vec<Value> = std::fs::read_to_string(rec.join("odom.jsonl"))
+        .unwrap()
+        .lines()
+        .map(|l| serde_json::from_str(l).unwrap())
+        .collect();
+    let m_per_tick = 2.0 * std::f64::consts::PI * 0.033 / 4096.0;
+    let (mut x, mut y, mut th) = (0.0f64, 0.0f64, 0.0f64);
+    let mut prev: Option<(i64, i64)> = None;
+    let mut k = 0;
+    let mut worst_pipe = 0.0f64;
+    let mut worst = (0.0f64, 0.0f64);
+    for (a, b) in frames.iter().zip(&truth) {
+        assert!((f(&a["t"]) - f(&b["t"])).abs() < 1e-3);
+        while k < odom.len() && f(&odom[k]["t"]) <= f(&a["t"]) {
+            let (l, r) = (
+                odom[k]["left_ticks"].as_i64().unwrap(),
+                odom[k]["right_ticks"].as_i64().unwrap(),
+            );
+            if let Some((l0, r0)) = prev {
+                let (dl, dr) = ((l - l0) as f64 * m_per_tick, (r - r0) as f64 * m_per_tick);
+                let (d, dth) = ((dl + dr) / 2.0, (dr - dl) / 0.16);
+                x += d * (th + dth / 2.0).cos();
+                y += d * (th + dth / 2.0).sin();
+                th += dth;
+            }
+            prev = Some((l, r));
+            k += 1;
+        }
+        let pipe = (f(&a["pose"]["x"]) - x).hypot(f(&a["pose"]["y"]) - y);
+        worst_pipe = worst_pipe.max(pipe);
+        let dp = (f(&a["pose"]["x"]) - f(&b["pose"]["x"]))
+            .hypot(f(&a["pose"]["y"]) - f(&b["pose"]["y"]));
+        let dth = (f(&a["pose"]["theta"]) - f(&b["pose"]["theta"]))
+            .sin()
+            .asin()
+            .abs();
+        worst = (worst.0.max(dp), worst.1.max(dth.to_degrees()));
+    }
+    println!(
+        "odometry replay over {travelled:.2} m: vs independent integration {worst_pipe:.5} m; vs truth worst position {:.3} m, heading {:.2}°",
+        worst.0, worst.1
+    );
+    assert!(travelled > 0.3, "the tour did not move ({travelled} m)");
+    assert!(
+        worst_pipe < 1e-3,
+        "runtime pose differs from the samples' integration by {worst_pipe} m"
+    );
+    // Against the truth, odometry alone with slip over 8 s, sampled at 20 Hz (up to 50 ms of a
+    // 1.2 rad/s turn between the frame's time and the last sample: 3.4°): plausibility only.
+    assert!(worst.0 < 0.05 && worst.1 < 10.0, "{worst:?}");
+    assert_eq!(last["faults"]["encoder_errors"], 0);
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn bad_odometry_lines_are_counted_not_fatal() {
+    let cap = tmp("odom-bad.bin");
+    capture(&cap, 10, Corruption::NONE);
+    let odom = tmp("odom-bad.jsonl");
+    std::fs::write(
+        &odom,
+        "{\"t\": 0.0, \"left_ticks\": 0, \"right_ticks\": 0}\nnot json\n{\"t\": 0.5, \"left_ticks\": \"x\"}\n{\"t\": 1.0, \"left_ticks\": 100, \"right_ticks\": 100}\n",
+    )
+    .unwrap();
+    let o = umbra(&[
+        "replay",
+        cap.to_str().unwrap(),
+        "--odom",
+        odom.to_str().unwrap(),
+        "--jsonl",
+        "-",
+        "--quiet",
+    ]);
+    assert!(o.status.success());
+    let s = String::from_utf8(o.stdout).unwrap();
+    let last: Value =
+        serde_json::from_str(s.lines().rfind(|l| l.starts_with('{')).unwrap()).unwrap();
+    assert_eq!(last["faults"]["encoder_errors"], 2);
+    assert!(last["pose"]["x"].as_f64().unwrap() > 0.0);
+    let o = umbra(&[
+        "replay",
+        cap.to_str().unwrap(),
+        "--odom",
+        "/nonexistent/odom.jsonl",
+    ]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("/nonexistent/odom.jsonl"));
+}

@@ -196,6 +196,12 @@ impl Lds01Sim {
         }
     }
 
+    /// Takes the encoder/compass samples of the revolution being sent (they are produced when
+    /// its first packet is emitted; drain them after every read so none is lost).
+    pub fn drain_odometry(&mut self) -> std::vec::Drain<'_, crate::scenario::OdomSample> {
+        self.odom.drain(..)
+    }
+
     /// Emits the next packet's 42 bytes into `out`.
     pub fn emit_packet(&mut self, out: &mut [u8; PACKET_LEN]) {
         if self.next_packet >= PACKETS_PER_REV {

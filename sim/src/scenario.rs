@@ -176,6 +176,28 @@ impl Scenario {
         self.start_pose
     }
 
+    /// What `umbra calibrate-compass` does on a robot: turn twice in place at the start spot
+    /// (0.5 rad/s, readings at 20 Hz) and fit the hard-iron offset from the readings. Runs on
+    /// copies: the scenario itself does not move.
+    pub fn calibrate_compass(&self) -> Option<perception::pose::HardIron> {
+        let mut compass = self.compass.clone();
+        let cfg = RobotConfig {
+            motion: crate::robot::Motion::Spin { rate_rad_s: 0.5 },
+            slip_sigma: 0.0,
+        };
+        let mut robot = Robot::new(&self.world, cfg, 0);
+        let mut fit = perception::pose::HardIronFit::default();
+        let samples = (2.0 * core::f32::consts::TAU / 0.5 / 0.05) as usize;
+        for _ in 0..samples {
+            for _ in 0..10 {
+                robot.step(0.005);
+            }
+            let m = compass.read(&robot.pose);
+            fit.add(m[0], m[1]);
+        }
+        fit.solve()
+    }
+
     /// Simulates the next revolution into `frame`, appending the encoder/compass samples that
     /// fall in it to `odom`.
     pub fn next_frame(&mut self, frame: &mut Frame, odom: &mut Vec<OdomSample>) {
