@@ -148,6 +148,38 @@ impl Status {
     }
 }
 
+/// A decoded packet of any kind.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct Packet {
+    /// Device id.
+    pub id: u8,
+    /// Instruction (0x55 for a status).
+    pub inst: u8,
+    params: [u8; MAX_PACKET_LEN],
+    len: u8,
+    /// Bytes it took on the wire.
+    pub wire_len: u8,
+}
+
+impl Packet {
+    /// Parameters, stuffing removed (for a status: the error byte, then the data).
+    pub fn params(&self) -> &[u8] {
+        &self.params[..usize::from(self.len).min(MAX_PACKET_LEN)]
+    }
+
+    /// The (address, length) of a READ instruction.
+    pub fn read_args(&self) -> Option<(u16, u16)> {
+        let p = self.params();
+        (self.inst == INST_READ && p.len() == 4).then(|| {
+            (
+                u16::from_le_bytes([p[0], p[1]]),
+                u16::from_le_bytes([p[2], p[3]]),
+            )
+        })
+    }
+}
+
 /// Counters of the status decoder.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
@@ -156,7 +188,7 @@ pub struct DecoderStats {
     pub bytes_in: u64,
     /// Bytes not part of any status handed out.
     pub bytes_skipped: u64,
-    /// Status packets handed out.
+    /// Packets handed out (by `next_status`: status packets only).
     pub packets: u64,
     /// Candidates with a bad CRC.
     pub bad_crc: u64,
@@ -214,8 +246,34 @@ impl StatusDecoder {
     }
 
     /// Takes bytes from the front of `input` until a status packet is complete, and returns
-    /// it; `None` once `input` is used up.
+    /// it; `None` once `input` is used up. Valid packets that are not status packets (an
+    /// instruction echoed on a half-duplex bus) are counted in `not_status` and skipped.
     pub fn next_status(&mut self, input: &mut &[u8]) -> Option<Status> {
+        loop {
+            let p = self.next_packet(input)?;
+            if p.inst != INST_STATUS || p.len == 0 {
+                self.stats.packets -= 1;
+                self.stats.not_status += 1;
+                self.stats.bytes_skipped += u64::from(p.wire_len);
+                continue;
+            }
+            let mut status = Status {
+                id: p.id,
+                error: p.params[0],
+                data: [0; MAX_STATUS_DATA],
+                len: 0,
+            };
+            let data = &p.params()[1..];
+            let k = data.len().min(MAX_STATUS_DATA);
+            status.data[..k].copy_from_slice(&data[..k]);
+            status.len = k as u8;
+            return Some(status);
+        }
+    }
+
+    /// Takes bytes from the front of `input` until any valid packet (instruction or status) is
+    /// complete, and returns it with stuffing removed; `None` once `input` is used up.
+    pub fn next_packet(&mut self, input: &mut &[u8]) -> Option<Packet> {
         loop {
             // The length field, once buffered, must be plausible before it sizes anything.
             let mut need = 7;
@@ -267,25 +325,17 @@ impl StatusDecoder {
                     k += 1;
                 }
             }
-            if body[0] != INST_STATUS || k < 2 {
-                self.stats.not_status += 1;
-                self.stats.bytes_skipped += n as u64;
-                self.len = 0;
-                continue;
-            }
-            let mut status = Status {
+            let mut packet = Packet {
                 id: self.buf[4],
-                error: body[1],
-                data: [0; MAX_STATUS_DATA],
-                len: 0,
+                inst: body[0],
+                params: [0; MAX_PACKET_LEN],
+                len: (k - 1) as u8,
+                wire_len: n as u8,
             };
-            let data = &body[2..k];
-            let k = data.len().min(MAX_STATUS_DATA);
-            status.data[..k].copy_from_slice(&data[..k]);
-            status.len = k as u8;
+            packet.params[..k - 1].copy_from_slice(&body[1..k]);
             self.stats.packets += 1;
             self.len = 0;
-            return Some(status);
+            return Some(packet);
         }
     }
 

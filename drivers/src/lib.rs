@@ -10,6 +10,7 @@
 //! | [`lds01`]   | LDS-01 packets, streaming decoder, revolution assembler        | core   |
 //! | [`dynamixel`] | DYNAMIXEL Protocol 2.0 (OpenCR): CRC-16, stuffing, instruction emit, status decoder | core |
 //! | `serial`    | serial ports via `serialport`, as `embedded-io`; reopen with back-off | `std`  |
+//! | `opencr`    | OpenCR wheel encoders over DYNAMIXEL 2.0, timeouts, counted errors | `std`  |
 //!
 //! ## Guarantees
 //!
@@ -29,5 +30,7 @@
 
 pub mod dynamixel;
 pub mod lds01;
+#[cfg(feature = "std")]
+pub mod opencr;
 #[cfg(feature = "std")]
 pub mod serial;

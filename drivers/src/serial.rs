@@ -41,6 +41,19 @@ pub struct SerialConfig {
 }
 
 impl SerialConfig {
+    /// The OpenCR board (DYNAMIXEL 2.0 over USB serial): 1 Mbps, nothing sent on open/close,
+    /// short read timeout (the board answers within a few milliseconds).
+    pub fn opencr() -> Self {
+        SerialConfig {
+            baud: 1_000_000,
+            read_timeout: Duration::from_millis(5),
+            backoff_min: Duration::from_millis(100),
+            backoff_max: Duration::from_secs(2),
+            on_open: &[],
+            on_close: &[],
+        }
+    }
+
     /// The LDS-01: 230400 8N1, `b` on open, `e` on close.
     pub fn lds01() -> Self {
         SerialConfig {
@@ -76,6 +89,11 @@ pub enum LinkError {
         /// Device path.
         path: String,
     },
+    /// The port is closed, waiting to be reopened.
+    NotConnected {
+        /// Device path.
+        path: String,
+    },
 }
 
 impl fmt::Display for LinkError {
@@ -86,6 +104,9 @@ impl fmt::Display for LinkError {
             }
             LinkError::Io { path, kind } => write!(f, "serial port {path}: I/O error ({kind:?})"),
             LinkError::Eof { path } => write!(f, "serial port {path}: end of file (hang-up)"),
+            LinkError::NotConnected { path } => {
+                write!(f, "serial port {path}: not connected (reopening)")
+            }
         }
     }
 }
@@ -224,6 +245,31 @@ impl SerialLink {
                 LinkRead::Lost(LinkError::Io {
                     path: self.path.clone(),
                     kind: e.kind(),
+                })
+            }
+        }
+    }
+
+    /// Writes all of `bytes`. A failure closes the port; a closed port is reopened (with
+    /// back-off) by the next `write` or `read`.
+    pub fn write(&mut self, bytes: &[u8]) -> Result<(), LinkError> {
+        if self.port.is_none() {
+            // A request-response device is only ever written to: reopen from here too.
+            let _ = self.try_reopen();
+        }
+        let Some(port) = self.port.as_mut() else {
+            return Err(LinkError::NotConnected {
+                path: self.path.clone(),
+            });
+        };
+        match write_all(port, bytes) {
+            Ok(()) => Ok(()),
+            Err(kind) => {
+                self.stats.read_errors += 1;
+                self.lose();
+                Err(LinkError::Io {
+                    path: self.path.clone(),
+                    kind,
                 })
             }
         }

@@ -8,6 +8,7 @@ use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 
 use clap::Parser;
+use drivers::opencr::{OpencrConfig, OpencrReader};
 use firmware::cli::{Cli, Command, Common, LidarModel, Speed};
 use firmware::config::Config;
 use firmware::odom::{OdomFile, PoseState};
@@ -45,13 +46,21 @@ fn dispatch(cli: Cli) -> Result<(), Failure> {
                 None => LidarSource::sim(args.seed, args.seed),
             };
             println!("umbra: {}", source.describe());
-            if let Some(p) = &args.opencr {
-                log::warn!(
-                    "--opencr {p}: wheel-encoder support has not landed yet; no pose, robot assumed still"
-                );
-            } else if args.lidar.is_some() {
-                log::warn!("no --opencr named: no odometry, robot assumed still");
-            }
+            let opencr = match &args.opencr {
+                Some(p) => match OpencrReader::open(p, OpencrConfig::default()) {
+                    Ok(r) => Some(r),
+                    Err(e) => {
+                        log::warn!("{e}: no wheel encoders from that port");
+                        None
+                    }
+                },
+                None => {
+                    if args.lidar.is_some() {
+                        log::warn!("no --opencr named: no odometry, robot assumed still");
+                    }
+                    None
+                }
+            };
             if let Some(bus) = &args.compass {
                 log::warn!("--compass {bus}: compass support has not landed yet; ignored");
             }
@@ -60,7 +69,14 @@ fn dispatch(cli: Cli) -> Result<(), Failure> {
             } else {
                 Pacing::Max // the port paces itself
             };
-            let pose = source.is_simulated().then(|| {
+            let from_sim = opencr.is_none() && source.is_simulated();
+            let board = opencr.map(|board| PoseInput {
+                state: PoseState::new(cfg.pose_filter(None), false),
+                file: None,
+                queue: Default::default(),
+                opencr: Some(board),
+            });
+            let pose = board.or_else(|| from_sim.then(|| {
                 let hi = source.sim_hard_iron();
                 match hi {
                     Some(h) => log::info!(
@@ -74,8 +90,9 @@ fn dispatch(cli: Cli) -> Result<(), Failure> {
                     state: PoseState::new(cfg.pose_filter(hi), hi.is_some()),
                     file: None,
                     queue: Default::default(),
+                    opencr: None,
                 }
-            });
+            }));
             run_loop(
                 &mut source,
                 &cfg,
@@ -103,6 +120,7 @@ fn dispatch(cli: Cli) -> Result<(), Failure> {
                         state: PoseState::new(cfg.pose_filter(None), use_compass),
                         file: Some(file),
                         queue: Default::default(),
+                        opencr: None,
                     })
                 }
                 None => None,

@@ -15,6 +15,8 @@ use std::collections::VecDeque;
 use drivers::lds01::{Lds01Config, Lds01Faults, Lds01Stream};
 use perception::geometry::Pose2;
 
+use drivers::opencr::OpencrReader;
+
 use crate::odom::{OdomFile, OdomRecord, PoseState};
 
 use crate::output::{FaultsOut, LidarOut, OutputLine, PoseOut, TimingOut, stats_line};
@@ -66,11 +68,29 @@ pub struct PoseInput {
     pub file: Option<OdomFile>,
     /// Samples from a live source (the simulator), waiting for their frame.
     pub queue: VecDeque<OdomRecord>,
+    /// An OpenCR board, polled once per frame.
+    pub opencr: Option<OpencrReader>,
 }
 
 impl PoseInput {
     /// Feeds every sample up to sensor time `t` and returns the pose.
     fn advance(&mut self, t: f64) -> Pose2 {
+        if let Some(board) = self.opencr.as_mut() {
+            match board.poll() {
+                Ok((l, r)) => self.state.feed(&OdomRecord {
+                    t,
+                    left_ticks: Some(i64::from(l)),
+                    right_ticks: Some(i64::from(r)),
+                    mag_ut: None,
+                }),
+                Err(e) => {
+                    if self.state.encoder_errors == 0 {
+                        log::warn!("{e}; pose continues from the last good ticks");
+                    }
+                    self.state.encoder_errors += 1;
+                }
+            }
+        }
         if let Some(f) = self.file.as_mut() {
             f.advance(t, &mut self.state);
         }
