@@ -20,6 +20,24 @@ pub enum Command {
     Run(RunArgs),
     /// Run the same pipeline on a raw LiDAR capture file.
     Replay(ReplayArgs),
+    /// Fit the compass's hard-iron offset from readings taken while the robot turns, and write
+    /// it to the configuration.
+    CalibrateCompass(CalibrateArgs),
+}
+
+/// `umbra calibrate-compass`.
+#[derive(Debug, Args)]
+pub struct CalibrateArgs {
+    /// Odometry/compass JSON Lines recorded while the robot turned at least half a turn
+    /// (`mag_ut` samples). Without it, the simulated robot's compass is calibrated.
+    #[arg(long, value_name = "ODOM.jsonl")]
+    pub odom: Option<PathBuf>,
+    /// Write `[compass] hard_iron_ut` into this TOML file (created if absent).
+    #[arg(long, value_name = "PATH")]
+    pub write: Option<PathBuf>,
+    /// Seed of the simulated robot (without --odom).
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
 }
 
 /// LiDAR models (`--lidar-model`).

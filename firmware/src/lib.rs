@@ -4,6 +4,7 @@
 //!
 //! | module       | owns                                                        |
 //! |--------------|-------------------------------------------------------------|
+//! | [`calibrate`] | `umbra calibrate-compass`: hard-iron fit, coverage check, config write |
 //! | [`cli`]      | the command line of `interfaces.md` §1                      |
 //! | [`config`]   | the TOML configuration, defaults and validation             |
 //! | [`source`]   | LiDAR byte sources: serial port, capture file, simulated robot |
@@ -12,6 +13,7 @@
 //! | [`output`]   | the JSON output line (§3) and per-revolution statistics     |
 #![deny(unsafe_code, missing_docs)]
 
+pub mod calibrate;
 pub mod cli;
 pub mod config;
 pub mod odom;

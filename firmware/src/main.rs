@@ -9,6 +9,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 
 use clap::Parser;
 use drivers::opencr::{OpencrConfig, OpencrReader};
+use firmware::calibrate;
 use firmware::cli::{Cli, Command, Common, LidarModel, Speed};
 use firmware::config::Config;
 use firmware::odom::{OdomFile, PoseState};
@@ -101,6 +102,47 @@ fn dispatch(cli: Cli) -> Result<(), Failure> {
                 SecondsClock::Wall,
                 pose,
             )
+        }
+        Command::CalibrateCompass(args) => {
+            let (xy, bad, source) = match &args.odom {
+                Some(path) => {
+                    let (xy, bad) =
+                        calibrate::readings_from_file(path).map_err(|m| (EXIT_USAGE, m))?;
+                    (xy, bad, path.display().to_string())
+                }
+                None => {
+                    let xy = sim::scenario::Scenario::new(
+                        args.seed,
+                        &sim::scenario::ScenarioConfig::standard(),
+                    )
+                    .compass_spin_readings();
+                    (
+                        xy,
+                        0,
+                        format!(
+                            "the simulated robot (seed {}), two turns in place",
+                            args.seed
+                        ),
+                    )
+                }
+            };
+            let c =
+                calibrate::fit(&xy).map_err(|m| (EXIT_FAULT, format!("calibrate-compass: {m}")))?;
+            println!(
+                "umbra: compass calibration from {source}: {} readings ({bad} unreadable lines), {:.0}° covered; hard iron ({:.2}, {:.2}) µT, horizontal field {:.1} µT",
+                c.samples, c.coverage_deg, c.hard_iron.x_ut, c.hard_iron.y_ut, c.hard_iron.field_ut
+            );
+            match &args.write {
+                Some(path) => {
+                    calibrate::write_config(path, &c.hard_iron).map_err(|m| (EXIT_FAULT, m))?;
+                    println!("umbra: wrote [compass] hard_iron_ut to {}", path.display());
+                }
+                None => println!(
+                    "[compass]\nhard_iron_ut = [{:.2}, {:.2}]",
+                    c.hard_iron.x_ut, c.hard_iron.y_ut
+                ),
+            }
+            Ok(())
         }
         Command::Replay(args) => {
             let cfg = load_config(&args.common)?;

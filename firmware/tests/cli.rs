@@ -418,3 +418,39 @@ fn bad_odometry_lines_are_counted_not_fatal() {
     assert_eq!(o.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&o.stderr).contains("/nonexistent/odom.jsonl"));
 }
+
+#[test]
+fn calibrate_compass_writes_the_config_that_run_uses() {
+    let cfg = tmp("cal.toml");
+    let _ = std::fs::remove_file(&cfg);
+    let o = umbra(&["calibrate-compass", "--write", cfg.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let text = std::fs::read_to_string(&cfg).unwrap();
+    assert!(text.contains("hard_iron_ut"), "{text}");
+    let o = umbra(&[
+        "run",
+        "--frames",
+        "2",
+        "--quiet",
+        "--config",
+        cfg.to_str().unwrap(),
+    ]);
+    assert!(o.status.success());
+    // Half a turn of readings is refused with a clear message.
+    let odom = tmp("half-turn.jsonl");
+    let lines: String = (0..60)
+        .map(|i| {
+            let a = (i as f32 * 3.0_f32).to_radians();
+            format!(
+                "{{\"t\": {}, \"mag_ut\": [{}, {}, -40.0]}}\n",
+                i as f32 * 0.05,
+                5.0 + 20.0 * a.cos(),
+                20.0 * a.sin()
+            )
+        })
+        .collect();
+    std::fs::write(&odom, lines).unwrap();
+    let o = umbra(&["calibrate-compass", "--odom", odom.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("full turn"));
+}

@@ -176,24 +176,33 @@ impl Scenario {
         self.start_pose
     }
 
-    /// What `umbra calibrate-compass` does on a robot: turn twice in place at the start spot
-    /// (0.5 rad/s, readings at 20 Hz) and fit the hard-iron offset from the readings. Runs on
-    /// copies: the scenario itself does not move.
-    pub fn calibrate_compass(&self) -> Option<perception::pose::HardIron> {
+    /// The horizontal compass readings (µT) of what `umbra calibrate-compass` asks of a robot:
+    /// two turns in place at the start spot at 0.5 rad/s, readings at 20 Hz. Runs on copies:
+    /// the scenario itself does not move.
+    pub fn compass_spin_readings(&self) -> Vec<[f32; 2]> {
         let mut compass = self.compass.clone();
         let cfg = RobotConfig {
             motion: crate::robot::Motion::Spin { rate_rad_s: 0.5 },
             slip_sigma: 0.0,
         };
         let mut robot = Robot::new(&self.world, cfg, 0);
-        let mut fit = perception::pose::HardIronFit::default();
         let samples = (2.0 * core::f32::consts::TAU / 0.5 / 0.05) as usize;
-        for _ in 0..samples {
-            for _ in 0..10 {
-                robot.step(0.005);
-            }
-            let m = compass.read(&robot.pose);
-            fit.add(m[0], m[1]);
+        (0..samples)
+            .map(|_| {
+                for _ in 0..10 {
+                    robot.step(0.005);
+                }
+                let m = compass.read(&robot.pose);
+                [m[0], m[1]]
+            })
+            .collect()
+    }
+
+    /// The hard-iron fit of [`Scenario::compass_spin_readings`].
+    pub fn calibrate_compass(&self) -> Option<perception::pose::HardIron> {
+        let mut fit = perception::pose::HardIronFit::default();
+        for p in self.compass_spin_readings() {
+            fit.add(p[0], p[1]);
         }
         fit.solve()
     }
