@@ -8,6 +8,7 @@
 //! | module      | owns                                                          | needs  |
 //! |-------------|---------------------------------------------------------------|--------|
 //! | [`lds01`]   | LDS-01 packets, streaming decoder, revolution assembler        | core   |
+//! | `compass`   | LSM303AGR magnetometer over embedded-hal 1.0 I²C (`lsm303agr`), bounded waits | `compass` |
 //! | [`dynamixel`] | DYNAMIXEL Protocol 2.0 (OpenCR): CRC-16, stuffing, instruction emit, status decoder | core |
 //! | `serial`    | serial ports via `serialport`, as `embedded-io`; reopen with back-off | `std`  |
 //! | `opencr`    | OpenCR wheel encoders over DYNAMIXEL 2.0, timeouts, counted errors | `std`  |
@@ -28,6 +29,8 @@
 #![cfg_attr(not(any(test, feature = "std")), no_std)]
 #![deny(unsafe_code, missing_docs)]
 
+#[cfg(feature = "compass")]
+pub mod compass;
 pub mod dynamixel;
 pub mod lds01;
 #[cfg(feature = "std")]

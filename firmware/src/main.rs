@@ -62,8 +62,12 @@ fn dispatch(cli: Cli) -> Result<(), Failure> {
                     None
                 }
             };
-            if let Some(bus) = &args.compass {
-                log::warn!("--compass {bus}: compass support has not landed yet; ignored");
+            let compass = args.compass.as_deref().and_then(open_compass);
+            let compass_calibrated = cfg.compass.hard_iron_ut.is_some();
+            if compass.is_some() && !compass_calibrated {
+                log::warn!(
+                    "no [compass] hard_iron_ut in the configuration: compass readings ignored (run `umbra calibrate-compass`)"
+                );
             }
             let pacing = if source.is_simulated() {
                 Pacing::RealTime
@@ -76,6 +80,8 @@ fn dispatch(cli: Cli) -> Result<(), Failure> {
                 file: None,
                 queue: Default::default(),
                 opencr: Some(board),
+                compass: None,
+                compass_errors: 0,
             });
             let pose = board.or_else(|| from_sim.then(|| {
                 let hi = source.sim_hard_iron();
@@ -92,8 +98,27 @@ fn dispatch(cli: Cli) -> Result<(), Failure> {
                     file: None,
                     queue: Default::default(),
                     opencr: None,
+                    compass: None,
+                    compass_errors: 0,
                 }
             }));
+            // A compass on the bus joins whatever gives the pose (or starts one on its own).
+            let pose = match (pose, compass) {
+                (Some(mut p), Some(c)) => {
+                    p.state.use_compass = compass_calibrated;
+                    p.compass = Some(c);
+                    Some(p)
+                }
+                (None, Some(c)) => Some(PoseInput {
+                    state: PoseState::new(cfg.pose_filter(None), compass_calibrated),
+                    file: None,
+                    queue: Default::default(),
+                    opencr: None,
+                    compass: Some(c),
+                    compass_errors: 0,
+                }),
+                (p, None) => p,
+            };
             run_loop(
                 &mut source,
                 &cfg,
@@ -163,6 +188,8 @@ fn dispatch(cli: Cli) -> Result<(), Failure> {
                         file: Some(file),
                         queue: Default::default(),
                         opencr: None,
+                        compass: None,
+                        compass_errors: 0,
                     })
                 }
                 None => None,
@@ -179,6 +206,30 @@ fn dispatch(cli: Cli) -> Result<(), Failure> {
                 SecondsClock::Sensor,
                 pose,
             )
+        }
+    }
+}
+
+/// Opens an LSM303AGR on the I²C bus at `bus` (e.g. `/dev/i2c-1`); a failure is reported once
+/// and the runtime goes on without a compass.
+fn open_compass(bus: &str) -> Option<firmware::runner::CompassReader> {
+    let i2c = match linux_embedded_hal::I2cdev::new(bus) {
+        Ok(i2c) => i2c,
+        Err(e) => {
+            log::warn!("--compass {bus}: cannot open the I2C bus ({e}); running without a compass");
+            return None;
+        }
+    };
+    match drivers::compass::Lsm303Compass::new(i2c, linux_embedded_hal::Delay) {
+        Ok(mut c) => {
+            let bus = bus.to_owned();
+            Some(Box::new(move || {
+                c.read_ut().map_err(|e| format!("--compass {bus}: {e}"))
+            }))
+        }
+        Err(e) => {
+            log::warn!("--compass {bus}: no LSM303AGR answers ({e}); running without a compass");
+            None
         }
     }
 }

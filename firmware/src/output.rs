@@ -99,6 +99,8 @@ pub struct FaultsOut {
     pub lidar_link_lost: u64,
     /// Link reopens.
     pub lidar_link_reopened: u64,
+    /// Compass reads that failed (bus error, timeout).
+    pub compass_errors: u64,
 }
 
 impl FaultsOut {
@@ -117,6 +119,7 @@ impl FaultsOut {
             lidar_invalid_readings: invalid_readings,
             lidar_link_lost: link.0,
             lidar_link_reopened: link.1,
+            compass_errors: 0,
         }
     }
 }

@@ -70,7 +70,14 @@ pub struct PoseInput {
     pub queue: VecDeque<OdomRecord>,
     /// An OpenCR board, polled once per frame.
     pub opencr: Option<OpencrReader>,
+    /// A compass, read once per frame (µT, robot frame).
+    pub compass: Option<CompassReader>,
+    /// Compass reads that failed.
+    pub compass_errors: u64,
 }
+
+/// Reads the compass once; the error names the device.
+pub type CompassReader = Box<dyn FnMut() -> Result<[f32; 3], String>>;
 
 impl PoseInput {
     /// Feeds every sample up to sensor time `t` and returns the pose.
@@ -88,6 +95,22 @@ impl PoseInput {
                         log::warn!("{e}; pose continues from the last good ticks");
                     }
                     self.state.encoder_errors += 1;
+                }
+            }
+        }
+        if let Some(read) = self.compass.as_mut() {
+            match read() {
+                Ok(m) => self.state.feed(&OdomRecord {
+                    t,
+                    left_ticks: None,
+                    right_ticks: None,
+                    mag_ut: Some(m),
+                }),
+                Err(e) => {
+                    if self.compass_errors == 0 {
+                        log::warn!("{e}; heading continues on odometry");
+                    }
+                    self.compass_errors += 1;
                 }
             }
         }
@@ -248,16 +271,17 @@ fn emit_frame(
     }
     let t = rev.first_ray_time_s().max(0.0);
     let t_pose = Instant::now();
-    let (pose, encoder_errors, compass_rejected) = match opts.pose.as_mut() {
+    let (pose, encoder_errors, compass_rejected, compass_errors) = match opts.pose.as_mut() {
         Some(p) => {
             let pose = p.advance(t);
             (
                 pose,
                 p.state.encoder_errors,
                 u64::from(p.state.filter.compass_rejected()),
+                p.compass_errors,
             )
         }
-        None => (Pose2::IDENTITY, 0, 0),
+        None => (Pose2::IDENTITY, 0, 0, 0),
     };
     let pose_ms = t_pose.elapsed().as_secs_f64() * 1e3;
     let ingest_ms = ingest.as_secs_f64() * 1e3;
@@ -290,6 +314,7 @@ fn emit_frame(
             faults: FaultsOut {
                 encoder_errors,
                 compass_rejected,
+                compass_errors,
                 ..FaultsOut::new(
                     &stream.faults(),
                     summary.invalid_readings,
