@@ -25,10 +25,13 @@ pub struct Calibration {
     pub samples: usize,
     /// Heading coverage around the centre, degrees.
     pub coverage_deg: f32,
+    /// Mean vertical reading (hard iron included), µT: with the fitted horizontal strength, the
+    /// clean-field reference that screens disturbed readings.
+    pub vertical_ut: f32,
 }
 
-/// Fits the horizontal readings `xy` (µT).
-pub fn fit(xy: &[[f32; 2]]) -> Result<Calibration, String> {
+/// Fits the readings `xy` (µT, x y z; the fit uses x and y).
+pub fn fit(xy: &[[f32; 3]]) -> Result<Calibration, String> {
     let mut f = HardIronFit::default();
     for p in xy {
         f.add(p[0], p[1]);
@@ -65,11 +68,12 @@ pub fn fit(xy: &[[f32; 2]]) -> Result<Calibration, String> {
         hard_iron: h,
         samples: xy.len(),
         coverage_deg,
+        vertical_ut: xy.iter().map(|p| p[2]).sum::<f32>() / xy.len() as f32,
     })
 }
 
 /// The `mag_ut` readings of an odometry JSON Lines file (other lines skipped, bad ones counted).
-pub fn readings_from_file(path: &Path) -> Result<(Vec<[f32; 2]>, usize), String> {
+pub fn readings_from_file(path: &Path) -> Result<(Vec<[f32; 3]>, usize), String> {
     let text = std::fs::read_to_string(path)
         .map_err(|e| format!("--odom {}: cannot read: {e}", path.display()))?;
     let mut out = Vec::new();
@@ -78,7 +82,7 @@ pub fn readings_from_file(path: &Path) -> Result<(Vec<[f32; 2]>, usize), String>
         match serde_json::from_str::<OdomRecord>(line) {
             Ok(OdomRecord {
                 mag_ut: Some(m), ..
-            }) if m.iter().all(|v| v.is_finite()) => out.push([m[0], m[1]]),
+            }) if m.iter().all(|v| v.is_finite()) => out.push(m),
             Ok(_) => {}
             Err(_) => bad += 1,
         }
@@ -86,9 +90,10 @@ pub fn readings_from_file(path: &Path) -> Result<(Vec<[f32; 2]>, usize), String>
     Ok((out, bad))
 }
 
-/// Writes `hard_iron_ut` into the `[compass]` table of the TOML file at `path` (created if
-/// absent; other settings kept, comments not).
-pub fn write_config(path: &Path, h: &HardIron) -> Result<(), String> {
+/// Writes `hard_iron_ut` and `field_reference_ut` into the `[compass]` table of the TOML file
+/// at `path` (created if absent; other settings kept, comments not).
+pub fn write_config(path: &Path, c: &Calibration) -> Result<(), String> {
+    let h = &c.hard_iron;
     let mut table: toml::Table = match std::fs::read_to_string(path) {
         Ok(text) => toml::from_str(&text).map_err(|e| format!("{}: {e}", path.display()))?,
         Err(e) if e.kind() == std::io::ErrorKind::NotFound => toml::Table::new(),
@@ -108,6 +113,13 @@ pub fn write_config(path: &Path, h: &HardIron) -> Result<(), String> {
             toml::Value::Float(round(h.y_ut)),
         ]),
     );
+    compass.insert(
+        "field_reference_ut".into(),
+        toml::Value::Array(vec![
+            toml::Value::Float(round(h.field_ut)),
+            toml::Value::Float(round(c.vertical_ut)),
+        ]),
+    );
     let text = toml::to_string(&table).map_err(|e| e.to_string())?;
     std::fs::write(path, text).map_err(|e| format!("{}: {e}", path.display()))
 }
@@ -118,11 +130,11 @@ mod test {
 
     #[test]
     fn full_turn_fits_half_turn_refused() {
-        let circle = |from: f32, to: f32| -> Vec<[f32; 2]> {
+        let circle = |from: f32, to: f32| -> Vec<[f32; 3]> {
             (0..100)
                 .map(|i| {
                     let a = (from + (to - from) * i as f32 / 99.0).to_radians();
-                    [8.0 + 20.0 * a.cos(), -5.0 + 20.0 * a.sin()]
+                    [8.0 + 20.0 * a.cos(), -5.0 + 20.0 * a.sin(), -40.0]
                 })
                 .collect()
         };
@@ -137,14 +149,20 @@ mod test {
     fn writes_into_existing_config() {
         let p = std::env::temp_dir().join(format!("umbra-cal-{}.toml", std::process::id()));
         std::fs::write(&p, "[lidar]\nchecksum = \"count\"\n").unwrap();
-        let h = HardIron {
-            x_ut: 1.234,
-            y_ut: -5.678,
-            field_ut: 20.0,
+        let c = Calibration {
+            hard_iron: HardIron {
+                x_ut: 1.234,
+                y_ut: -5.678,
+                field_ut: 20.0,
+            },
+            samples: 100,
+            coverage_deg: 360.0,
+            vertical_ut: -41.26,
         };
-        write_config(&p, &h).unwrap();
+        write_config(&p, &c).unwrap();
         let cfg = crate::config::Config::load(&p).unwrap();
         assert_eq!(cfg.compass.hard_iron_ut, Some([1.23, -5.68]));
+        assert_eq!(cfg.compass.field_reference_ut, Some([20.0, -41.26]));
         assert_eq!(cfg.lidar.checksum, crate::config::ChecksumSetting::Count);
         let _ = std::fs::remove_file(p);
     }

@@ -18,6 +18,7 @@
 //!
 //! [compass]
 //! hard_iron_ut = [12.0, -3.5]  # from `umbra calibrate-compass`; absent: compass not used
+//! field_reference_ut = [20.1, -41.3]  # clean field at calibration (horizontal, vertical)
 //! offset_deg = 0.0             # magnetic declination + mount offset
 //! field_tolerance = 0.08       # accepted deviation of the horizontal field strength
 //! ```
@@ -109,6 +110,9 @@ impl Default for OdometrySettings {
 pub struct CompassSettings {
     /// Hard-iron offset (x, y), µT; `None`: the compass is not used.
     pub hard_iron_ut: Option<[f32; 2]>,
+    /// Clean-field reference from the calibration (horizontal strength, vertical reading), µT:
+    /// readings that differ are disturbed and not used.
+    pub field_reference_ut: Option<[f32; 2]>,
     /// Declination plus mount offset, degrees.
     pub offset_deg: f32,
     /// Accepted deviation of the horizontal field strength, fraction.
@@ -119,6 +123,7 @@ impl Default for CompassSettings {
     fn default() -> Self {
         CompassSettings {
             hard_iron_ut: None,
+            field_reference_ut: None,
             offset_deg: 0.0,
             field_tolerance: HeadingConfig::default().field_tolerance,
         }
@@ -200,8 +205,10 @@ impl Config {
         Ok(())
     }
 
-    /// A pose filter with these settings; the hard-iron offset given overrides the file's.
-    pub fn pose_filter(&self, hard_iron: Option<[f32; 2]>) -> PoseFilter {
+    /// A pose filter with these settings; a calibration given (hard iron, field reference)
+    /// overrides the file's.
+    pub fn pose_filter(&self, calibration: Option<([f32; 2], [f32; 2])>) -> PoseFilter {
+        let hard_iron = calibration.map(|c| c.0);
         let o = &self.odometry;
         let odo = OdometryConfig {
             wheel_radius_m: o.wheel_radius_m,
@@ -214,7 +221,11 @@ impl Config {
             ..HeadingConfig::default()
         };
         let hi = hard_iron.or(self.compass.hard_iron_ut).unwrap_or([0.0; 2]);
-        PoseFilter::new(odo, heading, (hi[0], hi[1]))
+        let mut f = PoseFilter::new(odo, heading, (hi[0], hi[1]));
+        if let Some(r) = calibration.map(|c| c.1).or(self.compass.field_reference_ut) {
+            f.set_field_reference(r[0], r[1]);
+        }
+        f
     }
 
     /// The LDS-01 driver settings.

@@ -84,9 +84,9 @@ fn dispatch(cli: Cli) -> Result<(), Failure> {
                 compass_errors: 0,
             });
             let pose = board.or_else(|| from_sim.then(|| {
-                let hi = source.sim_hard_iron();
-                match hi {
-                    Some(h) => log::info!(
+                let cal = source.sim_calibration();
+                match cal {
+                    Some((h, _)) => log::info!(
                         "simulated compass calibrated by a two-turn spin: hard iron ({:.2}, {:.2}) µT",
                         h[0],
                         h[1]
@@ -94,7 +94,7 @@ fn dispatch(cli: Cli) -> Result<(), Failure> {
                     None => log::warn!("simulated compass calibration failed: heading from odometry only"),
                 }
                 PoseInput {
-                    state: PoseState::new(cfg.pose_filter(hi), hi.is_some()),
+                    state: PoseState::new(cfg.pose_filter(cal), cal.is_some()),
                     file: None,
                     queue: Default::default(),
                     opencr: None,
@@ -159,12 +159,15 @@ fn dispatch(cli: Cli) -> Result<(), Failure> {
             );
             match &args.write {
                 Some(path) => {
-                    calibrate::write_config(path, &c.hard_iron).map_err(|m| (EXIT_FAULT, m))?;
-                    println!("umbra: wrote [compass] hard_iron_ut to {}", path.display());
+                    calibrate::write_config(path, &c).map_err(|m| (EXIT_FAULT, m))?;
+                    println!(
+                        "umbra: wrote [compass] hard_iron_ut and field_reference_ut to {}",
+                        path.display()
+                    );
                 }
                 None => println!(
-                    "[compass]\nhard_iron_ut = [{:.2}, {:.2}]",
-                    c.hard_iron.x_ut, c.hard_iron.y_ut
+                    "[compass]\nhard_iron_ut = [{:.2}, {:.2}]\nfield_reference_ut = [{:.2}, {:.2}]",
+                    c.hard_iron.x_ut, c.hard_iron.y_ut, c.hard_iron.field_ut, c.vertical_ut
                 ),
             }
             Ok(())

@@ -67,7 +67,7 @@ impl PoseState {
         }
         if let (Some(m), true) = (r.mag_ut, self.use_compass) {
             if m.iter().all(|v| v.is_finite()) {
-                self.filter.compass(m[0], m[1]);
+                self.filter.compass_3d(m[0], m[1], m[2]);
             } else {
                 self.encoder_errors += 1;
             }

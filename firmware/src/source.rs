@@ -54,8 +54,8 @@ pub enum LidarSource {
         sim: Box<Lds01Sim>,
         /// Room seed, for messages.
         room_seed: u64,
-        /// Hard-iron offset fitted by a calibration spin of the simulated compass.
-        hard_iron: Option<[f32; 2]>,
+        /// Hard iron and field reference from a calibration spin of the simulated compass.
+        calibration: Option<([f32; 2], [f32; 2])>,
     },
 }
 
@@ -85,18 +85,25 @@ impl LidarSource {
     /// as `umbra calibrate-compass` would on a robot.
     pub fn sim(room_seed: u64, _noise_seed: u64) -> Self {
         let scenario = Scenario::new(room_seed, &ScenarioConfig::standard());
-        let hard_iron = scenario.calibrate_compass().map(|h| [h.x_ut, h.y_ut]);
+        let readings = scenario.compass_spin_readings();
+        let calibration = crate::calibrate::fit(&readings).ok().map(|c| {
+            (
+                [c.hard_iron.x_ut, c.hard_iron.y_ut],
+                [c.hard_iron.field_ut, c.vertical_ut],
+            )
+        });
         LidarSource::Sim {
             sim: Box::new(Lds01Sim::from_scenario(scenario)),
             room_seed,
-            hard_iron,
+            calibration,
         }
     }
 
-    /// The calibrated hard-iron offset of the simulated compass, if this is the simulator.
-    pub fn sim_hard_iron(&self) -> Option<[f32; 2]> {
+    /// The calibration (hard iron, field reference) of the simulated compass, if this is the
+    /// simulator.
+    pub fn sim_calibration(&self) -> Option<([f32; 2], [f32; 2])> {
         match self {
-            LidarSource::Sim { hard_iron, .. } => *hard_iron,
+            LidarSource::Sim { calibration, .. } => *calibration,
             _ => None,
         }
     }

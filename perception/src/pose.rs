@@ -284,6 +284,8 @@ pub struct PoseFilter {
     init_field: f32,
     north: Option<f32>,
     field_ref: f32,
+    /// Clean-field reference from the calibration: (horizontal strength, vertical reading).
+    reference: Option<(f32, f32)>,
     since_fix_s: f32,
     rejected: u32,
     accepted: u32,
@@ -306,6 +308,7 @@ impl PoseFilter {
             init_field: 0.0,
             north: None,
             field_ref: 0.0,
+            reference: None,
             since_fix_s: 0.0,
             rejected: 0,
             accepted: 0,
@@ -362,10 +365,41 @@ impl PoseFilter {
         (libm::atan2f(y, x), libm::hypotf(x, y))
     }
 
-    /// Feeds a magnetometer reading (µT, robot frame).
+    /// Sets the clean-field reference measured at calibration, away from steel: horizontal
+    /// strength (the fitted circle's radius) and the vertical reading (hard iron included). With
+    /// it, readings are screened against it — also while north is being fixed, so that a
+    /// magnetically disturbed start spot cannot bias north — and the vertical component is
+    /// checked too (see [`PoseFilter::compass_3d`]).
+    pub fn set_field_reference(&mut self, horizontal_ut: f32, vertical_ut: f32) {
+        self.reference = Some((horizontal_ut, vertical_ut));
+        self.field_ref = horizontal_ut;
+    }
+
+    /// Feeds a magnetometer reading (µT, robot frame) with its vertical component.
+    pub fn compass_3d(&mut self, mx: f32, my: f32, mz: f32) -> CompassVerdict {
+        self.compass_inner(mx, my, Some(mz))
+    }
+
+    /// Feeds a magnetometer reading (µT, robot frame), horizontal components only.
     pub fn compass(&mut self, mx: f32, my: f32) -> CompassVerdict {
+        self.compass_inner(mx, my, None)
+    }
+
+    /// `true` if the reading matches the clean-field reference (always, without one).
+    fn clean(&self, field: f32, mz: Option<f32>) -> bool {
+        match self.reference {
+            None => true,
+            Some((h, v)) => {
+                let tol = self.cfg.field_tolerance * h;
+                libm::fabsf(field - h) <= tol && mz.is_none_or(|z| libm::fabsf(z - v) <= tol)
+            }
+        }
+    }
+
+    fn compass_inner(&mut self, mx: f32, my: f32, mz: Option<f32>) -> CompassVerdict {
         let (psi, field) = self.raw_angle(mx, my);
         let verdict = match self.north {
+            None if !self.clean(field, mz) => CompassVerdict::RejectedField,
             None => {
                 // North in the map frame = ψ + θ at the time of the reading.
                 let a = psi + self.pose.theta;
@@ -375,7 +409,9 @@ impl PoseFilter {
                 self.init_n += 1;
                 if self.init_n >= self.cfg.init_samples.max(1) {
                     self.north = Some(libm::atan2f(self.init_s, self.init_c));
-                    self.field_ref = self.init_field / f32::from(self.init_n);
+                    if self.reference.is_none() {
+                        self.field_ref = self.init_field / f32::from(self.init_n);
+                    }
                 }
                 CompassVerdict::Initialising
             }
@@ -383,7 +419,8 @@ impl PoseFilter {
                 let heading = wrap_angle(north - psi + self.cfg.offset_rad);
                 let innovation = wrap_angle(heading - self.pose.theta);
                 let field_ok = libm::fabsf(field - self.field_ref)
-                    <= self.cfg.field_tolerance * self.field_ref;
+                    <= self.cfg.field_tolerance * self.field_ref
+                    && self.clean(field, mz);
                 let r = self.cfg.compass_sigma_rad * self.cfg.compass_sigma_rad;
                 let gate = self.cfg.gate_sigmas * libm::sqrtf(self.var + r);
                 let gate_ok =

@@ -44,8 +44,9 @@ pub struct Compass {
     pub north_rad: f32,
     /// Hard-iron offset, robot frame, µT.
     pub hard_iron_ut: [f32; 3],
-    /// Disturbance sources: position and field direction (unit, world frame).
-    sources: Vec<(Point2, Point2)>,
+    /// Disturbance sources: position and field direction (unit 3-D vector, world frame: steel
+    /// near the floor bends the field in every direction, the vertical included).
+    sources: Vec<(Point2, [f32; 3])>,
     rng: ChaCha8Rng,
 }
 
@@ -62,8 +63,11 @@ impl Compass {
         ];
         let mut sources = Vec::new();
         let mut add = |p: Point2, rng: &mut ChaCha8Rng| {
+            // Uniform on the sphere.
             let a: f32 = rng.random_range(-core::f32::consts::PI..core::f32::consts::PI);
-            sources.push((p, Point2::new(a.cos(), a.sin())));
+            let z: f32 = rng.random_range(-1.0..1.0);
+            let r = (1.0 - z * z).sqrt();
+            sources.push((p, [r * a.cos(), r * a.sin(), z]));
         };
         for c in world.clutter.iter().filter(|c| c.kind == "pillar") {
             add(c.centre, &mut rng);
@@ -84,34 +88,36 @@ impl Compass {
         }
     }
 
-    /// The field at `pose` without noise, world frame horizontal part (µT).
-    fn horizontal_world(&self, at: Point2) -> Point2 {
-        let mut f = Point2::new(
+    /// The field at `at` without noise, world frame (µT): the earth's plus the disturbances.
+    pub fn field_world(&self, at: Point2) -> [f32; 3] {
+        let mut f = [
             self.cfg.horizontal_ut * self.north_rad.cos(),
             self.cfg.horizontal_ut * self.north_rad.sin(),
-        );
+            self.cfg.vertical_ut,
+        ];
         for (p, dir) in &self.sources {
             let d = at.distance(*p).max(0.1);
             let s = self.cfg.disturbance_ut * (0.3 / d).powi(3);
-            f = Point2::new(f.x + dir.x * s, f.y + dir.y * s);
+            for (fi, di) in f.iter_mut().zip(dir) {
+                *fi += di * s;
+            }
         }
         f
     }
 
-    /// `true` if local disturbances change the field at `at` by more than `ut`.
-    pub fn disturbed(&self, at: Point2, ut: f32) -> bool {
-        let clean = Point2::new(
-            self.cfg.horizontal_ut * self.north_rad.cos(),
-            self.cfg.horizontal_ut * self.north_rad.sin(),
-        );
-        self.horizontal_world(at).distance(clean) > ut
+    /// How much the disturbances add to the field at `at`, µT.
+    pub fn disturbance_ut(&self, at: Point2) -> f32 {
+        self.sources
+            .iter()
+            .map(|(p, _)| self.cfg.disturbance_ut * (0.3 / at.distance(*p).max(0.1)).powi(3))
+            .sum()
     }
 
     /// One reading at `pose`, robot frame, µT.
     pub fn read(&mut self, pose: &Pose2) -> [f32; 3] {
-        let h = self.horizontal_world(Point2::new(pose.x, pose.y));
+        let h = self.field_world(Point2::new(pose.x, pose.y));
         let (s, c) = pose.theta.sin_cos();
-        let body = [c * h.x + s * h.y, -s * h.x + c * h.y, self.cfg.vertical_ut];
+        let body = [c * h[0] + s * h[1], -s * h[0] + c * h[1], h[2]];
         let mut out = [0.0; 3];
         for (i, o) in out.iter_mut().enumerate() {
             let n: f32 = (0..3)

@@ -6,9 +6,10 @@
 //!   at every reading;
 //! * **fusion**, `perception::pose::PoseFilter`.
 //!
-//! Each scenario first spins the robot in place for two turns and fits the compass's hard-iron
-//! offset from those readings (what `umbra calibrate-compass` does), then drives for the given
-//! time with encoders and compass sampled at 20 Hz. Errors are against the simulator's true pose
+//! Each scenario first spins the robot in place for two turns in the room's most open spot and
+//! fits the compass's hard-iron offset and clean-field reference from those readings (what
+//! `umbra calibrate-compass` does), then drives from the start spot for the given time with
+//! encoders and compass sampled at 20 Hz. Errors are against the simulator's true pose
 //! in the map frame (the robot's start pose).
 
 use perception::geometry::{Pose2, wrap_angle};
@@ -90,16 +91,25 @@ pub fn run(i: usize, seed: u64, seconds: f32, motion: Motion) -> EvalRow {
     let s = scenario_seed(seed, i);
     let world = World::generate(s, &WorldConfig::default());
     let mut compass = Compass::new(&world, CompassConfig::default(), s ^ 1);
-    // Calibration: two turns in place at 0.5 rad/s.
-    let mut spin = Robot::new(
-        &world,
-        RobotConfig {
-            motion: Motion::Spin { rate_rad_s: 0.5 },
-            slip_sigma: 0.0,
-        },
-        s ^ 2,
-    );
+    // Calibration, as a user does it: two turns in place at 0.5 rad/s in the most open spot
+    // (least disturbed of 200 candidates), giving the hard iron and the clean-field reference.
+    let mut rng = <rand_chacha::ChaCha8Rng as rand::SeedableRng>::seed_from_u64(s ^ 4);
+    let spot = (0..200)
+        .filter_map(|_| world.free_point(&mut rng, 0.4))
+        .min_by(|a, b| {
+            compass
+                .disturbance_ut(*a)
+                .total_cmp(&compass.disturbance_ut(*b))
+        })
+        .unwrap_or(world.robot_start);
+    let spin_cfg = RobotConfig {
+        motion: Motion::Spin { rate_rad_s: 0.5 },
+        slip_sigma: 0.0,
+    };
+    let mut spin = Robot::new(&world, spin_cfg, s ^ 2);
+    spin.place(Pose2::new(spot.x, spot.y, 0.0));
     let mut fit = HardIronFit::default();
+    let mut vertical = 0.0f32;
     let spin_samples = (2.0 * core::f32::consts::TAU / 0.5 / SAMPLE_S) as usize;
     for _ in 0..spin_samples {
         for _ in 0..SUBSTEPS {
@@ -107,8 +117,10 @@ pub fn run(i: usize, seed: u64, seconds: f32, motion: Motion) -> EvalRow {
         }
         let m = compass.read(&spin.pose);
         fit.add(m[0], m[1]);
+        vertical += m[2] / spin_samples as f32;
     }
-    let hi = fit.solve().map_or((0.0, 0.0), |h| (h.x_ut, h.y_ut));
+    let fitted = fit.solve();
+    let hi = fitted.map_or((0.0, 0.0), |h| (h.x_ut, h.y_ut));
     let hard_iron_error_ut = ((hi.0 - compass.hard_iron_ut[0]).powi(2)
         + (hi.1 - compass.hard_iron_ut[1]).powi(2))
     .sqrt();
@@ -124,6 +136,9 @@ pub fn run(i: usize, seed: u64, seconds: f32, motion: Motion) -> EvalRow {
     let map = robot.pose.inverse();
     let odo_cfg = OdometryConfig::BURGER;
     let mut fusion = PoseFilter::new(odo_cfg, HeadingConfig::default(), hi);
+    if let Some(h) = fitted {
+        fusion.set_field_reference(h.field_ut, vertical);
+    }
     let mut odometry = PoseFilter::new(odo_cfg, HeadingConfig::default(), hi);
     let mut overwrite = Pose2::IDENTITY;
     let mut ow_ticks = TickCounter::default();
@@ -145,6 +160,11 @@ pub fn run(i: usize, seed: u64, seconds: f32, motion: Motion) -> EvalRow {
         },
     );
     let samples = (seconds / SAMPLE_S) as usize;
+    // The encoders' zero: a sample at t = 0, before the robot moves (the map frame's origin).
+    let (l0, r0) = robot.ticks();
+    odometry.encoders(l0, r0, 0.0);
+    fusion.encoders(l0, r0, 0.0);
+    ow_ticks.step(l0, r0, &odo_cfg);
     let mut truth = Pose2::IDENTITY;
     for _ in 0..samples {
         for _ in 0..SUBSTEPS {
@@ -155,7 +175,7 @@ pub fn run(i: usize, seed: u64, seconds: f32, motion: Motion) -> EvalRow {
         truth = map.compose(&robot.pose);
         odometry.encoders(l, r, SAMPLE_S);
         fusion.encoders(l, r, SAMPLE_S);
-        fusion.compass(m[0], m[1]);
+        fusion.compass_3d(m[0], m[1], m[2]);
         let step = ow_ticks.step(l, r, &odo_cfg);
         let dth = match fusion.compass_heading(m[0], m[1]) {
             Some(h) => wrap_angle(h - overwrite.theta),

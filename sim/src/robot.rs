@@ -135,6 +135,11 @@ impl Robot {
         }
     }
 
+    /// Moves the robot to `pose` (for a calibration spin somewhere else than the start).
+    pub fn place(&mut self, pose: Pose2) {
+        self.pose = pose;
+    }
+
     /// Simulation time, s.
     pub fn time_s(&self) -> f64 {
         self.t

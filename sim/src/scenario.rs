@@ -176,10 +176,10 @@ impl Scenario {
         self.start_pose
     }
 
-    /// The horizontal compass readings (µT) of what `umbra calibrate-compass` asks of a robot:
+    /// The compass readings (µT, x y z) of what `umbra calibrate-compass` asks of a robot:
     /// two turns in place at the start spot at 0.5 rad/s, readings at 20 Hz. Runs on copies:
     /// the scenario itself does not move.
-    pub fn compass_spin_readings(&self) -> Vec<[f32; 2]> {
+    pub fn compass_spin_readings(&self) -> Vec<[f32; 3]> {
         let mut compass = self.compass.clone();
         let cfg = RobotConfig {
             motion: crate::robot::Motion::Spin { rate_rad_s: 0.5 },
@@ -192,8 +192,7 @@ impl Scenario {
                 for _ in 0..10 {
                     robot.step(0.005);
                 }
-                let m = compass.read(&robot.pose);
-                [m[0], m[1]]
+                compass.read(&robot.pose)
             })
             .collect()
     }
