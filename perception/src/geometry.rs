@@ -33,6 +33,18 @@ impl Point2 {
     pub fn distance(self, other: Point2) -> f32 {
         (self - other).norm()
     }
+
+    /// Distance to the segment from `a` to `b`.
+    pub fn distance_to_segment(self, a: Point2, b: Point2) -> f32 {
+        let e = b - a;
+        let l2 = e.x * e.x + e.y * e.y;
+        let t = if l2 > 0.0 {
+            (((self - a).x * e.x + (self - a).y * e.y) / l2).clamp(0.0, 1.0)
+        } else {
+            0.0
+        };
+        self.distance(Point2::new(a.x + t * e.x, a.y + t * e.y))
+    }
 }
 
 impl Add for Point2 {
@@ -121,6 +133,14 @@ mod test {
 
     fn close(a: f32, b: f32) -> bool {
         (a - b).abs() < 1e-4
+    }
+
+    #[test]
+    fn segment_distance() {
+        let (a, b) = (Point2::new(0.0, 0.0), Point2::new(2.0, 0.0));
+        assert!(close(Point2::new(1.0, 1.0).distance_to_segment(a, b), 1.0));
+        assert!(close(Point2::new(3.0, 0.0).distance_to_segment(a, b), 1.0));
+        assert!(close(Point2::new(-1.0, 0.0).distance_to_segment(a, a), 1.0));
     }
 
     #[test]

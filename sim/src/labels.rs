@@ -85,17 +85,6 @@ fn returns_of(frames: [&Frame; 3], surface: Surface) -> usize {
         .count()
 }
 
-fn segment_distance(p: Point2, a: Point2, b: Point2) -> f32 {
-    let e = b - a;
-    let l2 = e.x * e.x + e.y * e.y;
-    let t = if l2 > 0.0 {
-        (((p - a).x * e.x + (p - a).y * e.y) / l2).clamp(0.0, 1.0)
-    } else {
-        0.0
-    };
-    p.distance(Point2::new(a.x + t * e.x, a.y + t * e.y))
-}
-
 /// The box of a footprint seen from `lidar` (world pose of the LiDAR), if it is in range.
 pub fn footprint_box(
     class: ObjectClass,
@@ -107,7 +96,7 @@ pub fn footprint_box(
     let local = footprint.map(|c| inv.transform(c));
     let origin = Point2::default();
     let near = (0..4)
-        .map(|i| segment_distance(origin, local[i], local[(i + 1) % 4]))
+        .map(|i| origin.distance_to_segment(local[i], local[(i + 1) % 4]))
         .fold(f32::INFINITY, f32::min);
     let far = local.iter().map(|p| p.norm()).fold(0.0, f32::max);
     if near > cfg.max_range_m || near < 1e-3 {

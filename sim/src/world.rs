@@ -118,16 +118,7 @@ impl Shape {
     /// Distance from `p` to this shape's outline.
     pub fn distance(&self, p: Point2) -> f32 {
         match *self {
-            Shape::Segment { a, b } => {
-                let e = b - a;
-                let l2 = e.x * e.x + e.y * e.y;
-                let t = if l2 > 0.0 {
-                    (((p - a).x * e.x + (p - a).y * e.y) / l2).clamp(0.0, 1.0)
-                } else {
-                    0.0
-                };
-                p.distance(Point2::new(a.x + t * e.x, a.y + t * e.y))
-            }
+            Shape::Segment { a, b } => p.distance_to_segment(a, b),
             Shape::Circle { c, r } => (p.distance(c) - r).max(0.0),
         }
     }
