@@ -32,6 +32,12 @@ pub struct CalibrateArgs {
     /// (`mag_ut` samples). Without it, the simulated robot's compass is calibrated.
     #[arg(long, value_name = "ODOM.jsonl")]
     pub odom: Option<PathBuf>,
+    /// Record live from an LSM303AGR on this I²C bus (e.g. /dev/i2c-1) while the robot turns.
+    #[arg(long, value_name = "BUS")]
+    pub compass: Option<String>,
+    /// How long to record live, s.
+    #[arg(long, default_value_t = 30.0)]
+    pub seconds: f64,
     /// Write `[compass] hard_iron_ut` into this TOML file (created if absent).
     #[arg(long, value_name = "PATH")]
     pub write: Option<PathBuf>,

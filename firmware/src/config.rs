@@ -16,6 +16,12 @@
 //! wheel_separation_m = 0.160
 //! ticks_per_rev = 4096
 //!
+//! [opencr]                 # DYNAMIXEL 2.0 on /dev/ttyACM0 at 1 Mbps
+//! id = 200
+//! left_addr = 136           # present position, i32; firmware versions differ
+//! right_addr = 140
+//! timeout_ms = 20
+//!
 //! [compass]
 //! hard_iron_ut = [12.0, -3.5]  # from `umbra calibrate-compass`; absent: compass not used
 //! field_reference_ut = [20.1, -41.3]  # clean field at calibration (horizontal, vertical)
@@ -27,6 +33,7 @@ use std::fmt;
 use std::path::{Path, PathBuf};
 
 use drivers::lds01::{AssemblerConfig, ChecksumPolicy, Lds01Config};
+use drivers::opencr::OpencrConfig;
 use perception::pose::{HeadingConfig, OdometryConfig, PoseFilter};
 use serde::Deserialize;
 
@@ -104,6 +111,32 @@ impl Default for OdometrySettings {
     }
 }
 
+/// `[opencr]`: where the OpenCR firmware keeps the wheel positions (firmware versions differ).
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct OpencrSettings {
+    /// DYNAMIXEL id of the board.
+    pub id: u8,
+    /// Control-table address of the left wheel's present position (i32).
+    pub left_addr: u16,
+    /// Control-table address of the right wheel's present position (i32).
+    pub right_addr: u16,
+    /// Longest wait for an answer, ms.
+    pub timeout_ms: u64,
+}
+
+impl Default for OpencrSettings {
+    fn default() -> Self {
+        let d = OpencrConfig::default();
+        OpencrSettings {
+            id: d.id,
+            left_addr: d.left_addr,
+            right_addr: d.right_addr,
+            timeout_ms: d.timeout.as_millis() as u64,
+        }
+    }
+}
+
 /// `[compass]`.
 #[derive(Debug, Clone, PartialEq, Deserialize)]
 #[serde(default, deny_unknown_fields)]
@@ -140,6 +173,8 @@ pub struct Config {
     pub runtime: RuntimeSettings,
     /// Wheel geometry.
     pub odometry: OdometrySettings,
+    /// OpenCR control table.
+    pub opencr: OpencrSettings,
     /// Compass calibration and gates.
     pub compass: CompassSettings,
 }
@@ -226,6 +261,16 @@ impl Config {
             f.set_field_reference(r[0], r[1]);
         }
         f
+    }
+
+    /// The OpenCR reader settings.
+    pub fn opencr(&self) -> OpencrConfig {
+        OpencrConfig {
+            id: self.opencr.id,
+            left_addr: self.opencr.left_addr,
+            right_addr: self.opencr.right_addr,
+            timeout: std::time::Duration::from_millis(self.opencr.timeout_ms),
+        }
     }
 
     /// The LDS-01 driver settings.

@@ -8,7 +8,7 @@ use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 
 use clap::Parser;
-use drivers::opencr::{OpencrConfig, OpencrReader};
+use drivers::opencr::OpencrReader;
 use firmware::calibrate;
 use firmware::cli::{Cli, Command, Common, LidarModel, Speed};
 use firmware::config::Config;
@@ -48,7 +48,7 @@ fn dispatch(cli: Cli) -> Result<(), Failure> {
             };
             println!("umbra: {}", source.describe());
             let opencr = match &args.opencr {
-                Some(p) => match OpencrReader::open(p, OpencrConfig::default()) {
+                Some(p) => match OpencrReader::open(p, cfg.opencr()) {
                     Ok(r) => Some(r),
                     Err(e) => {
                         log::warn!("{e}: no wheel encoders from that port");
@@ -129,13 +129,35 @@ fn dispatch(cli: Cli) -> Result<(), Failure> {
             )
         }
         Command::CalibrateCompass(args) => {
-            let (xy, bad, source) = match &args.odom {
-                Some(path) => {
+            let (xy, bad, source) = match (&args.odom, &args.compass) {
+                (_, Some(bus)) => {
+                    let mut read = open_compass(bus).ok_or((
+                        EXIT_FAULT,
+                        format!("calibrate-compass: no compass on {bus}"),
+                    ))?;
+                    println!(
+                        "umbra: turn the robot slowly in place, at least one full turn, for {} s…",
+                        args.seconds
+                    );
+                    let mut xy = Vec::new();
+                    let mut bad = 0;
+                    let end = std::time::Instant::now()
+                        + std::time::Duration::from_secs_f64(args.seconds);
+                    while std::time::Instant::now() < end {
+                        match read() {
+                            Ok(m) => xy.push(m),
+                            Err(_) => bad += 1,
+                        }
+                        std::thread::sleep(std::time::Duration::from_millis(50));
+                    }
+                    (xy, bad, format!("{bus} (live, {} s)", args.seconds))
+                }
+                (Some(path), None) => {
                     let (xy, bad) =
                         calibrate::readings_from_file(path).map_err(|m| (EXIT_USAGE, m))?;
                     (xy, bad, path.display().to_string())
                 }
-                None => {
+                (None, None) => {
                     let xy = sim::scenario::Scenario::new(
                         args.seed,
                         &sim::scenario::ScenarioConfig::standard(),
