@@ -52,6 +52,23 @@ impl PoseState {
         }
     }
 
+    /// The pose at time `t`, between the last sample fed and `next` (a later one not yet fed):
+    /// the encoder step to `next` is taken at constant wheel speed. Without a usable `next`, the
+    /// pose after the last sample.
+    pub fn pose_at(&self, t: f64, next: Option<&OdomRecord>) -> perception::geometry::Pose2 {
+        let pose = self.filter.pose();
+        let (Some(t0), Some(n)) = (self.last_t, next) else {
+            return pose;
+        };
+        match (n.left_ticks, n.right_ticks) {
+            (Some(l), Some(r)) if n.t > t0 && t > t0 => {
+                let f = ((t - t0) / (n.t - t0)) as f32;
+                self.filter.interpolate(l as i32, r as i32, f)
+            }
+            _ => pose,
+        }
+    }
+
     /// Feeds one sample.
     pub fn feed(&mut self, r: &OdomRecord) {
         if !r.t.is_finite() {
@@ -94,6 +111,11 @@ impl OdomFile {
             pending: None,
             line_no: 0,
         })
+    }
+
+    /// The next sample not yet fed (after [`OdomFile::advance`]: the first one past `until`).
+    pub fn peek(&self) -> Option<&OdomRecord> {
+        self.pending.as_ref()
     }
 
     /// Feeds every sample with `t ≤ until` to `state`.

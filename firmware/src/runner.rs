@@ -124,7 +124,14 @@ impl PoseInput {
             self.state.feed(&r);
             self.queue.pop_front();
         }
-        self.state.filter.pose()
+        // The frame's time lies between two samples: interpolate to it.
+        let next = self
+            .file
+            .as_ref()
+            .and_then(|f| f.peek())
+            .or(self.queue.front())
+            .copied();
+        self.state.pose_at(t, next.as_ref())
     }
 }
 

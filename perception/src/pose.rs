@@ -90,6 +90,11 @@ pub struct TickCounter {
 }
 
 impl TickCounter {
+    /// `true` before the first sample.
+    pub fn is_empty(&self) -> bool {
+        self.last.is_none()
+    }
+
     /// The step since the previous sample (zero for the first one).
     pub fn step(&mut self, left: i32, right: i32, cfg: &OdometryConfig) -> WheelStep {
         let step = match self.last {
@@ -358,6 +363,19 @@ impl PoseFilter {
         self.since_fix_s += dt;
     }
 
+    /// The pose a `fraction` (0..1) of the way from the last encoder sample to a later one at
+    /// `(left, right)`, without feeding it: the pose at a time between two samples, assuming
+    /// constant wheel speeds over the step. Returns the current pose before the first sample.
+    pub fn interpolate(&self, left: i32, right: i32, fraction: f32) -> Pose2 {
+        let mut ticks = self.ticks;
+        if ticks.is_empty() {
+            return self.pose;
+        }
+        let step = ticks.step(left, right, &self.odo);
+        let f = fraction.clamp(0.0, 1.0);
+        integrate(&self.pose, step.distance() * f, step.dtheta(&self.odo) * f)
+    }
+
     /// The compass heading in the map frame from a reading (µT, robot frame), if initialised.
     fn raw_angle(&self, mx: f32, my: f32) -> (f32, f32) {
         let (x, y) = (mx - self.hard_iron.0, my - self.hard_iron.1);
@@ -488,6 +506,22 @@ mod test {
             f.pose().theta
         );
         assert!(f.heading_variance() > 0.0);
+    }
+
+    #[test]
+    fn interpolation_between_samples() {
+        let cfg = OdometryConfig::BURGER;
+        let one_m = (1.0 / cfg.m_per_tick()) as i32;
+        let mut f = PoseFilter::new(cfg, HeadingConfig::default(), (0.0, 0.0));
+        assert_eq!(f.interpolate(one_m, one_m, 0.5), Pose2::IDENTITY);
+        f.encoders(0, 0, 0.0);
+        let half = f.interpolate(one_m, one_m, 0.5);
+        assert!((half.x - 0.5).abs() < 1e-3);
+        assert_eq!(
+            f.pose(),
+            Pose2::IDENTITY,
+            "interpolation must not feed the filter"
+        );
     }
 
     #[test]

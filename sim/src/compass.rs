@@ -120,10 +120,7 @@ impl Compass {
         let body = [c * h[0] + s * h[1], -s * h[0] + c * h[1], h[2]];
         let mut out = [0.0; 3];
         for (i, o) in out.iter_mut().enumerate() {
-            let n: f32 = (0..3)
-                .map(|_| self.rng.random_range(-1.0..1.0f32))
-                .sum::<f32>()
-                * self.cfg.noise_ut;
+            let n = crate::noise::unit(&mut self.rng) * self.cfg.noise_ut;
             *o = body[i] + self.hard_iron_ut[i] + n;
         }
         out

@@ -93,9 +93,8 @@ impl LidarModel {
         }
     }
 
-    /// Roughly normal noise in about [−1.7, 1.7]·σ with σ = 1 (sum of three uniforms).
     fn gauss(&mut self) -> f32 {
-        (0..3).map(|_| self.rng.random_range(-1.0..1.0f32)).sum()
+        crate::noise::unit(&mut self.rng)
     }
 
     /// The speed of the next revolution, rpm.

@@ -15,6 +15,7 @@
 //! | [`scenario`]  | world + robot + sensors stepped one revolution (frame) at a time      |
 //! | [`labels`]    | Method B boxes from footprints, per-reading labels                    |
 //! | [`dataset`]   | dataset writers: YOLO layout, Method A labels, replay recordings      |
+//! | [`noise`]     | the bounded, unit-σ noise every sensor model draws from               |
 //! | [`picture`]   | a PNG of a scene for people to look at                                |
 //! | [`pose_eval`] | drift of odometry, compass overwrite and our fusion on the simulator   |
 //! | [`corrupt`]   | a noisy serial line: bit flips, inserted and dropped bytes, with truth |
@@ -26,6 +27,7 @@ pub mod dataset;
 pub mod grid;
 pub mod labels;
 pub mod lds01;
+pub mod noise;
 pub mod picture;
 pub mod pose_eval;
 pub mod robot;

@@ -203,10 +203,7 @@ impl Robot {
         let a = (dt / SLIP_TAU_S).min(1.0);
         let kick = self.cfg.slip_sigma * (2.0 * a).sqrt();
         for w in 0..2 {
-            let g: f32 = (0..3)
-                .map(|_| self.rng.random_range(-1.0..1.0f32))
-                .sum::<f32>()
-                * 0.577;
+            let g = crate::noise::unit(&mut self.rng);
             self.slip_state[w] += -self.slip_state[w] * a + kick * g;
         }
         let sl = dl * WHEEL_RADIUS * (1.0 - self.slip_bias[0] - self.slip_state[0]);
