@@ -247,7 +247,7 @@ pub fn in_memory(cfg: &DatasetConfig) -> (usize, u64) {
     let per: Vec<(usize, u64)> = (0..cfg.scenarios)
         .into_par_iter()
         .map(|i| {
-            let (mut n, mut h) = (0usize, 0xcbf2_9ce4_8422_2325u64);
+            let (mut n, mut h) = (0usize, FNV_OFFSET);
             let mut line = String::new();
             simulate(
                 i,
@@ -269,11 +269,16 @@ pub fn in_memory(cfg: &DatasetConfig) -> (usize, u64) {
     let frames = per.iter().map(|p| p.0).sum();
     let digest = per
         .iter()
-        .fold(0xcbf2_9ce4_8422_2325u64, |h, p| fnv(h, &p.1.to_le_bytes()));
+        .fold(FNV_OFFSET, |h, p| fnv(h, &p.1.to_le_bytes()));
     (frames, digest)
 }
 
-fn fnv(mut h: u64, bytes: &[u8]) -> u64 {
+/// FNV-1a offset basis: the starting value of [`fnv`].
+pub const FNV_OFFSET: u64 = 0xcbf2_9ce4_8422_2325;
+
+/// FNV-1a of `bytes`, continuing from `h` (start with [`FNV_OFFSET`]): the digest used for
+/// determinism checks.
+pub fn fnv(mut h: u64, bytes: &[u8]) -> u64 {
     for &b in bytes {
         h = (h ^ u64::from(b)).wrapping_mul(0x100_0000_01b3);
     }

@@ -197,15 +197,6 @@ impl Scenario {
             .collect()
     }
 
-    /// The hard-iron fit of [`Scenario::compass_spin_readings`].
-    pub fn calibrate_compass(&self) -> Option<perception::pose::HardIron> {
-        let mut fit = perception::pose::HardIronFit::default();
-        for p in self.compass_spin_readings() {
-            fit.add(p[0], p[1]);
-        }
-        fit.solve()
-    }
-
     /// Simulates the next revolution into `frame`, appending the encoder/compass samples that
     /// fall in it to `odom`.
     pub fn next_frame(&mut self, frame: &mut Frame, odom: &mut Vec<OdomSample>) {

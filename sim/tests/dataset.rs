@@ -5,7 +5,7 @@ use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
 use drivers::lds01::{Lds01Config, Lds01Stream};
-use sim::dataset::{DatasetConfig, generate, simulate};
+use sim::dataset::{DatasetConfig, FNV_OFFSET, fnv, generate, simulate};
 
 fn tmp(name: &str) -> PathBuf {
     let d = std::env::temp_dir().join(format!("umbra-ds-{}-{name}", std::process::id()));
@@ -23,12 +23,7 @@ fn tree_hashes(dir: &Path) -> BTreeMap<String, u64> {
             if p.is_dir() {
                 stack.push(p);
             } else {
-                let h = std::fs::read(&p)
-                    .unwrap()
-                    .iter()
-                    .fold(0xcbf2_9ce4_8422_2325u64, |h, &b| {
-                        (h ^ u64::from(b)).wrapping_mul(0x100_0000_01b3)
-                    });
+                let h = fnv(FNV_OFFSET, &std::fs::read(&p).unwrap());
                 out.insert(p.strip_prefix(dir).unwrap().display().to_string(), h);
             }
         }

@@ -17,7 +17,7 @@ use std::time::{Duration, Instant};
 
 use drivers::lds01::{Lds01Config, Lds01Stream, PACKET_LEN};
 use drivers::serial::{LinkRead, SerialConfig, SerialLink};
-use serialport::{SerialPort, TTYPort};
+use serialport::TTYPort;
 use sim::lds01::{Lds01Sim, Lds01SimConfig};
 use sim::world::World;
 
@@ -29,18 +29,10 @@ struct Link {
     master: TTYPort,
 }
 
-/// Opens a pty pair and points `link` at its slave side; the slave handle is closed so that
-/// the reader can open it.
 fn plug(link: &Path) -> Link {
-    let (mut master, slave) = TTYPort::pair().expect("pty pair");
-    let name = slave.name().expect("slave name");
-    drop(slave);
-    master.set_timeout(Duration::from_millis(100)).unwrap();
-    let tmp = link.with_extension("new");
-    let _ = std::fs::remove_file(&tmp);
-    std::os::unix::fs::symlink(&name, &tmp).unwrap();
-    std::fs::rename(&tmp, link).unwrap();
-    Link { master }
+    Link {
+        master: umbra_tests::plug_pty(link, Duration::from_millis(100)),
+    }
 }
 
 /// Waits up to `timeout` for `byte` to arrive on the master side.

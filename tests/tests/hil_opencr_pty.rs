@@ -16,20 +16,12 @@ use drivers::dynamixel::{INST_STATUS, StatusDecoder, emit};
 use drivers::opencr::{OpencrConfig, OpencrReader};
 use perception::geometry::{Pose2, wrap_angle};
 use perception::pose::{HeadingConfig, OdometryConfig, PoseFilter};
-use serialport::{SerialPort, TTYPort};
+use serialport::TTYPort;
 use sim::robot::{Motion, Robot, RobotConfig};
 use sim::world::World;
 
 fn plug(link: &Path) -> TTYPort {
-    let (mut master, slave) = TTYPort::pair().expect("pty pair");
-    let name = slave.name().expect("slave name");
-    drop(slave);
-    master.set_timeout(Duration::from_millis(5)).unwrap();
-    let tmp = link.with_extension("new");
-    let _ = std::fs::remove_file(&tmp);
-    std::os::unix::fs::symlink(&name, &tmp).unwrap();
-    std::fs::rename(&tmp, link).unwrap();
-    master
+    umbra_tests::plug_pty(link, Duration::from_millis(5))
 }
 
 /// Serves READs on `master` until `stop`, stepping `robot` in real time.
