@@ -10,13 +10,29 @@
 //! | [`class`]      | the object classes both methods report, with their wire names |
 //! | [`pose`]       | wheel odometry, hard-iron fit, compass/odometry heading filter |
 //! | [`raster`]     | three revolutions as the 64 × 384 × 3 image of Method B (bit-exact spec) |
+//! | [`cloud`]      | Method A's global point cloud: a fixed ring with aging |
+//! | [`dbscan`]     | adaptive-ε DBSCAN, grid-indexed and allocation-free |
+//! | [`shape`]      | centroid, principal-axes and minimum-area boxes of point sets |
+//! | [`walls`]      | the wall test, line segments fitted to walls, corners |
+//! | [`doors`]      | door frames from pairs of wall segments |
+//! | [`merge`]      | fragments (legs, pieces) merged into objects, with guards |
+//! | [`features`]   | the 9-D feature vector, in the object's frame or the map's |
+//! | [`method_a`]   | the geometric pipeline end to end, classifier as a parameter |
 //!
-//! The global point cloud, DBSCAN, walls and doors, features and YOLO decoding
-//! arrive with their issues; each capacity is a named constant listed in `memory-budget.md`.
+//! YOLO decoding arrives with its issue; each capacity is a named constant listed in
+//! `memory-budget.md`.
 #![cfg_attr(not(any(test, feature = "std")), no_std)]
 #![deny(unsafe_code, missing_docs)]
 
 pub mod class;
+pub mod cloud;
+pub mod dbscan;
+pub mod doors;
+pub mod features;
 pub mod geometry;
+pub mod merge;
+pub mod method_a;
 pub mod pose;
 pub mod raster;
+pub mod shape;
+pub mod walls;

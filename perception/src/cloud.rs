@@ -1,0 +1,290 @@
+//! The global point cloud of Method A: a fixed-capacity ring of map-frame points that every
+//! revolution feeds and ages.
+//!
+//! Each revolution first drops the oldest [`CloudConfig::drop_fraction`] of the points (5 % by
+//! default, rounded down), then appends its own returns transformed by the pose. With `n`
+//! returns a revolution the cloud settles where the drop equals the inflow, `n / fraction`
+//! points: 7,200 at 360 returns and 5 %. [`CLOUD_CAPACITY`] leaves room above that (7,200 +
+//! the 360 of the newest revolution, and a lower drop fraction); when the ring is full anyway,
+//! a new point overwrites the oldest and [`GlobalCloud::overwritten`] counts it, so the cloud
+//! degrades into a shorter memory, never into an error.
+//!
+//! Points that are not finite are refused and counted ([`GlobalCloud::rejected`]): NaN and
+//! infinite ranges must be filtered upstream, and this is the guard if they are not.
+
+use crate::geometry::{Point2, Pose2};
+
+/// Points the cloud holds at most (see the module docs for the sizing).
+pub const CLOUD_CAPACITY: usize = 8192;
+
+/// Cloud settings.
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct CloudConfig {
+    /// Fraction of the points dropped (oldest first) at the start of every revolution.
+    pub drop_fraction: f32,
+    /// Shortest range kept, metres (the LDS-01's blind zone is 0.12 m).
+    pub range_min_m: f32,
+    /// Longest range kept, metres (the LDS-01 is specified to 3.5 m).
+    pub range_max_m: f32,
+}
+
+impl Default for CloudConfig {
+    fn default() -> Self {
+        CloudConfig {
+            drop_fraction: 0.05,
+            range_min_m: 0.12,
+            range_max_m: 3.5,
+        }
+    }
+}
+
+/// One revolution to add: ranges by 1° bin (bin `d` at `d`° counter-clockwise from the
+/// sensor's forward axis, 0 = no return), with the robot's pose at the first and last ray.
+///
+/// The LDS-01 sweeps clockwise: raw reading `i` is bin `359 − i`, taken at fraction `i / 360`
+/// of the revolution, so bin `d` is placed with the pose interpolated at `(359 − d) / 360`
+/// between `start` and `end`. A turning robot's scan is de-skewed this way.
+#[derive(Debug, Clone, Copy)]
+pub struct Scan<'a> {
+    /// Ranges by bin, metres.
+    pub ranges: &'a [f32],
+    /// Robot pose (map frame) at the first ray.
+    pub start: Pose2,
+    /// Robot pose (map frame) at the last ray.
+    pub end: Pose2,
+    /// The LiDAR's pose on the robot.
+    pub mount: Pose2,
+}
+
+/// The cloud.
+#[derive(Clone)]
+pub struct GlobalCloud {
+    pts: [Point2; CLOUD_CAPACITY],
+    /// Index of the oldest point.
+    head: usize,
+    len: usize,
+    overwritten: u64,
+    rejected: u64,
+}
+
+impl Default for GlobalCloud {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl core::fmt::Debug for GlobalCloud {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.debug_struct("GlobalCloud")
+            .field("len", &self.len)
+            .field("overwritten", &self.overwritten)
+            .field("rejected", &self.rejected)
+            .finish()
+    }
+}
+
+impl GlobalCloud {
+    /// An empty cloud.
+    pub const fn new() -> Self {
+        GlobalCloud {
+            pts: [Point2::new(0.0, 0.0); CLOUD_CAPACITY],
+            head: 0,
+            len: 0,
+            overwritten: 0,
+            rejected: 0,
+        }
+    }
+
+    /// Points held.
+    pub fn len(&self) -> usize {
+        self.len
+    }
+
+    /// `true` when empty.
+    pub fn is_empty(&self) -> bool {
+        self.len == 0
+    }
+
+    /// Points overwritten because the ring was full.
+    pub fn overwritten(&self) -> u64 {
+        self.overwritten
+    }
+
+    /// Points refused because a coordinate was not finite.
+    pub fn rejected(&self) -> u64 {
+        self.rejected
+    }
+
+    /// Forgets every point (counters are kept).
+    pub fn clear(&mut self) {
+        self.head = 0;
+        self.len = 0;
+    }
+
+    /// Drops the oldest `floor(len · fraction)` points; returns how many went.
+    pub fn age(&mut self, fraction: f32) -> usize {
+        let f = if fraction.is_finite() {
+            fraction.clamp(0.0, 1.0)
+        } else {
+            0.0
+        };
+        let n = ((self.len as f32 * f) as usize).min(self.len);
+        self.head = (self.head + n) % CLOUD_CAPACITY;
+        self.len -= n;
+        n
+    }
+
+    /// Appends a point, overwriting the oldest when full. Returns `false` (and counts it) if
+    /// the point is not finite.
+    pub fn push(&mut self, p: Point2) -> bool {
+        if !(p.x.is_finite() && p.y.is_finite()) {
+            self.rejected += 1;
+            return false;
+        }
+        let tail = (self.head + self.len) % CLOUD_CAPACITY;
+        self.pts[tail] = p;
+        if self.len == CLOUD_CAPACITY {
+            self.head = (self.head + 1) % CLOUD_CAPACITY;
+            self.overwritten += 1;
+        } else {
+            self.len += 1;
+        }
+        true
+    }
+
+    /// Ages the cloud by one revolution and adds `scan`'s returns within the configured
+    /// range window; returns how many were added. Non-finite ranges are refused and counted.
+    pub fn add_scan(&mut self, scan: &Scan<'_>, cfg: &CloudConfig) -> usize {
+        self.age(cfg.drop_fraction);
+        let n = scan.ranges.len();
+        if n == 0 {
+            return 0;
+        }
+        let dtheta = crate::geometry::wrap_angle(scan.end.theta - scan.start.theta);
+        let step = core::f32::consts::TAU / n as f32;
+        let mut added = 0;
+        for (d, &r) in scan.ranges.iter().enumerate() {
+            if !r.is_finite() {
+                self.rejected += 1;
+                continue;
+            }
+            if r < cfg.range_min_m || r > cfg.range_max_m {
+                continue;
+            }
+            let u = (n - 1 - d) as f32 / n as f32;
+            let pose = Pose2::new(
+                scan.start.x + (scan.end.x - scan.start.x) * u,
+                scan.start.y + (scan.end.y - scan.start.y) * u,
+                scan.start.theta + dtheta * u,
+            );
+            let lidar = pose.compose(&scan.mount);
+            let local = Point2::from_polar(r, d as f32 * step);
+            if self.push(lidar.transform(local)) {
+                added += 1;
+            }
+        }
+        added
+    }
+
+    /// The points, oldest first, as two slices (the ring's two halves).
+    pub fn as_slices(&self) -> (&[Point2], &[Point2]) {
+        let end = self.head + self.len;
+        if end <= CLOUD_CAPACITY {
+            (&self.pts[self.head..end], &[])
+        } else {
+            (&self.pts[self.head..], &self.pts[..end - CLOUD_CAPACITY])
+        }
+    }
+
+    /// Every point, oldest first.
+    pub fn iter(&self) -> impl Iterator<Item = &Point2> + '_ {
+        let (a, b) = self.as_slices();
+        a.iter().chain(b.iter())
+    }
+}
+
+#[cfg(test)]
+mod test {
+    use super::*;
+
+    fn scan_of(r: f32) -> [f32; 360] {
+        [r; 360]
+    }
+
+    #[test]
+    fn settles_near_inflow_over_fraction() {
+        let mut c = GlobalCloud::new();
+        let ranges = scan_of(2.0);
+        let scan = Scan {
+            ranges: &ranges,
+            start: Pose2::IDENTITY,
+            end: Pose2::IDENTITY,
+            mount: Pose2::IDENTITY,
+        };
+        for _ in 0..400 {
+            c.add_scan(&scan, &CloudConfig::default());
+        }
+        // Equilibrium: after the drop 6,840–7,200 remain, plus 360 new.
+        assert!((7_100..=7_560).contains(&c.len()), "{}", c.len());
+        assert_eq!(c.overwritten(), 0);
+    }
+
+    #[test]
+    fn full_ring_overwrites_oldest() {
+        let mut c = GlobalCloud::new();
+        for i in 0..CLOUD_CAPACITY + 10 {
+            assert!(c.push(Point2::new(i as f32, 0.0)));
+        }
+        assert_eq!(c.len(), CLOUD_CAPACITY);
+        assert_eq!(c.overwritten(), 10);
+        assert_eq!(c.iter().next().unwrap().x, 10.0);
+        assert_eq!(c.iter().last().unwrap().x, (CLOUD_CAPACITY + 9) as f32);
+    }
+
+    #[test]
+    fn non_finite_refused() {
+        let mut c = GlobalCloud::new();
+        assert!(!c.push(Point2::new(f32::NAN, 0.0)));
+        assert!(!c.push(Point2::new(0.0, f32::INFINITY)));
+        let mut ranges = scan_of(0.0);
+        ranges[10] = f32::NAN;
+        ranges[11] = f32::INFINITY;
+        ranges[12] = 1.0;
+        let added = c.add_scan(
+            &Scan {
+                ranges: &ranges,
+                start: Pose2::IDENTITY,
+                end: Pose2::IDENTITY,
+                mount: Pose2::IDENTITY,
+            },
+            &CloudConfig::default(),
+        );
+        assert_eq!(added, 1);
+        assert_eq!(c.rejected(), 4);
+        assert!(c.age(f32::NAN) == 0 && c.len() == 1);
+    }
+
+    #[test]
+    fn bins_follow_rep103_and_deskew() {
+        let mut c = GlobalCloud::new();
+        let mut ranges = scan_of(0.0);
+        ranges[90] = 1.0; // left
+        ranges[359] = 1.0; // first ray
+        c.add_scan(
+            &Scan {
+                ranges: &ranges,
+                start: Pose2::IDENTITY,
+                end: Pose2::new(0.0, 0.0, 0.5),
+                mount: Pose2::IDENTITY,
+            },
+            &CloudConfig::default(),
+        );
+        let pts: std::vec::Vec<_> = c.iter().copied().collect();
+        // Bin 90 is read at 269/360 of the revolution.
+        let th = 0.5 * 269.0 / 360.0 + core::f32::consts::FRAC_PI_2;
+        assert!(pts[0].distance(Point2::from_polar(1.0, th)) < 1e-5);
+        // Bin 359 is the first ray: start pose.
+        assert!(pts[1].distance(Point2::from_polar(1.0, 359f32.to_radians())) < 1e-5);
+    }
+}
