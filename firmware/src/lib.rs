@@ -11,11 +11,15 @@
 //! | [`runner`]   | the frame loop: ingest → output, limits, pacing             |
 //! | [`odom`]     | odometry/compass input (`--odom` JSON Lines, the simulated robot) → pose |
 //! | [`output`]   | the JSON output line (§3) and per-revolution statistics     |
+//! | [`eval_a`]   | Method A scored against the simulator's truth; forest training rows |
+//! | [`confusion_png`] | the evaluation's confusion matrix as a PNG              |
 #![deny(unsafe_code, missing_docs)]
 
 pub mod calibrate;
 pub mod cli;
 pub mod config;
+pub mod confusion_png;
+pub mod eval_a;
 pub mod odom;
 pub mod output;
 pub mod runner;

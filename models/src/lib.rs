@@ -1,11 +1,23 @@
 //! # umbra models
 //!
-//! Home of the trained models: the Method A random forest compiled in as `const` tables and the
-//! Method B YOLOv8n runner (tract). Neither has landed yet (their issues are open); until then
-//! this crate only fixes the class order both will use.
+//! Home of the trained models.
+//!
+//! | module            | owns                                                           |
+//! |-------------------|----------------------------------------------------------------|
+//! | [`forest`]        | the Method A classifier at run time over `const` tables (`no_std`) |
+//! | [`forest_tables`] | the trained forest, generated from `models/data/forest-train.csv` |
+//! | `train`           | the forest trainer and table emitter (`std` feature, host only) |
+//!
+//! The Method B YOLOv8n runner (tract) arrives with its issue.
+#![cfg_attr(not(any(test, feature = "std")), no_std)]
 #![deny(unsafe_code, missing_docs)]
 
 pub use perception::class::ObjectClass;
+
+pub mod forest;
+pub mod forest_tables;
+#[cfg(feature = "std")]
+pub mod train;
 
 /// Class order of the model outputs (the index of a class score is its position here).
 pub const CLASSES: [ObjectClass; 4] = ObjectClass::ALL;

@@ -23,8 +23,10 @@
 //!
 //! # DBSCAN with per-point ε
 //!
-//! `j` is a neighbour of `i` when `|p_i − p_j| ≤ ε_i` (the point itself counts, as in
-//! scikit-learn). `i` is a core point with at least `min_samples` neighbours. Core points are
+//! `j` is a neighbour of `i` when `|p_i − p_j| ≤ min(ε_i, ε_j)` (the point itself counts, as
+//! in scikit-learn): two points are judged at the finer of their two scales, so the relation
+//! is symmetric and a sparse point's wide ε cannot reach into a dense object (the thin wall
+//! edge beside a box's shadow would otherwise bridge the 0.15 m to the box). `i` is a core point with at least `min_samples` neighbours. Core points are
 //! joined (union–find) with every core point in their neighbourhood; a border point joins the
 //! first core point, in cell order, that has it as a neighbour; the rest is noise. Clusters
 //! with fewer than `min_cluster_points` points are dropped (counted as noise). With one ε for
@@ -339,7 +341,9 @@ impl Dbscan {
                 for x in cx.saturating_sub(r)..=(cx + r).min(nx - 1) {
                     for j in cell_range(x, y) {
                         let d = sorted[j] - p;
-                        if d.x * d.x + d.y * d.y <= e2 && !f(j) {
+                        let ej = self.eps[j];
+                        let d2 = d.x * d.x + d.y * d.y;
+                        if d2 <= e2 && d2 <= ej * ej && !f(j) {
                             return;
                         }
                     }

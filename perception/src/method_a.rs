@@ -47,8 +47,11 @@ pub trait Classifier {
 /// A merged group of fragments before classification.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct Candidate {
-    /// Minimum-area box; its centre is the object's position.
+    /// Minimum-area box of the points.
     pub bbox: OrientedBox,
+    /// The object's estimated centre: the box centre, completed by the class's shape where
+    /// only its near side was seen ([`complete_centre`]).
+    pub centre: Point2,
     /// Feature vector.
     pub features: [f32; N_FEATURES],
     /// Points.
@@ -202,8 +205,10 @@ impl MethodA {
             };
             let f = features::features(parts, angle);
             let (class, score) = classifier.classify(&f);
+            let centre = class.map_or(bbox.centre, |c| complete_centre(c, &bbox, sensor));
             let _ = self.candidates.push(Candidate {
                 bbox,
+                centre,
                 features: f,
                 points: shape::count(parts) as u32,
                 fragments: np as u8,
@@ -264,6 +269,53 @@ impl MethodA {
     pub fn stats(&self) -> MethodAStats {
         self.stats
     }
+}
+
+/// The centre of an object of class `class` whose points span `bbox`, seen from `sensor`.
+///
+/// A LiDAR sees the near side of things: one face of a box, the two front legs of a desk. The
+/// class's proportions give the depth `D` the object should have across its long side `l`;
+/// when the points span less (`w < D`), the centre moves `(D − w) / 2` away from the sensor,
+/// perpendicular to the long side:
+///
+/// | class | `D` |
+/// |---|---|
+/// | chair (legs on a square) | `l` |
+/// | desk (legs on a 2:1 rectangle) | `l / 2` if two sides are seen (`w ≥ 0.3 m`) or `l ≥ 1.1 m` (a long side); else `2 l` (a short side) |
+/// | box (solid, 3:2) | `l / 1.5` if two faces are seen (`w ≥ 0.15 m`) or `l ≥ 0.48 m` (a long face); else `1.5 l` |
+///
+/// A lone leg (`l < 0.15 m`) has no direction to complete in: its box centre stands.
+pub fn complete_centre(class: ObjectClass, bbox: &OrientedBox, sensor: Point2) -> Point2 {
+    let (l, w) = (bbox.length, bbox.width);
+    if l < 0.15 {
+        return bbox.centre;
+    }
+    let depth = match class {
+        ObjectClass::Chair => l,
+        ObjectClass::Desk => {
+            if w >= 0.3 || l >= 1.1 {
+                l / 2.0
+            } else {
+                2.0 * l
+            }
+        }
+        ObjectClass::Box => {
+            if w >= 0.15 || l >= 0.48 {
+                l / 1.5
+            } else {
+                1.5 * l
+            }
+        }
+        ObjectClass::DoorFrame => return bbox.centre,
+    };
+    let shift = ((depth - w) / 2.0).max(0.0);
+    let (s, c) = (libm::sinf(bbox.angle), libm::cosf(bbox.angle));
+    let mut n = Point2::new(-s, c);
+    let away = bbox.centre - sensor;
+    if n.x * away.x + n.y * away.y < 0.0 {
+        n = Point2::new(-n.x, -n.y);
+    }
+    Point2::new(bbox.centre.x + n.x * shift, bbox.centre.y + n.y * shift)
 }
 
 #[cfg(test)]
@@ -343,6 +395,47 @@ mod test {
                 if best <= 3.5 { best } else { 0.0 }
             })
             .collect()
+    }
+
+    #[test]
+    fn centre_completion_moves_away_from_the_sensor() {
+        // Front face of a 0.6 × 0.4 box seen from below: the centre is 0.2 m further up.
+        let face = OrientedBox {
+            centre: Point2::new(0.0, 1.0),
+            angle: 0.0,
+            length: 0.6,
+            width: 0.01,
+        };
+        let c = complete_centre(ObjectClass::Box, &face, Point2::new(0.0, 0.0));
+        assert!(c.distance(Point2::new(0.0, 1.195)) < 1e-4, "{c:?}");
+        let c = complete_centre(ObjectClass::Box, &face, Point2::new(0.0, 3.0));
+        assert!(c.distance(Point2::new(0.0, 0.805)) < 1e-4, "{c:?}");
+        // Two front legs of a desk 1.6 m apart: depth 0.8 m.
+        let legs = OrientedBox {
+            length: 1.6,
+            width: 0.05,
+            ..face
+        };
+        let c = complete_centre(ObjectClass::Desk, &legs, Point2::new(0.0, 0.0));
+        assert!(c.distance(Point2::new(0.0, 1.375)) < 1e-4, "{c:?}");
+        // Two sides seen, or one leg: unchanged.
+        let full = OrientedBox { width: 0.4, ..face };
+        let part = OrientedBox { width: 0.3, ..face };
+        let c = complete_centre(ObjectClass::Box, &part, Point2::new(0.0, 0.0));
+        assert!(c.distance(Point2::new(0.0, 1.05)) < 1e-4, "{c:?}");
+        assert_eq!(
+            complete_centre(ObjectClass::Box, &full, Point2::default()),
+            full.centre
+        );
+        let leg = OrientedBox {
+            length: 0.05,
+            width: 0.04,
+            ..face
+        };
+        assert_eq!(
+            complete_centre(ObjectClass::Chair, &leg, Point2::default()),
+            leg.centre
+        );
     }
 
     #[test]

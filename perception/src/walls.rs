@@ -12,6 +12,9 @@
 //! at its farthest vertex from the chord while that is over `split_tol_m` (iterative end-point
 //! fit), and each run of at least [`MIN_RUN_VERTICES`] vertices and `min_segment_m` length gets
 //! a total-least-squares line; its ends are the projections of the run's first and last vertex.
+//! Consecutive runs on one line (split apart by an outlier) are merged back into one segment;
+//! without that step a wall with a few ghost returns breaks into pieces whose gaps look like
+//! doorways.
 //!
 //! **Corners**: consecutive segments of one polyline whose directions differ by more than
 //! `corner_min_deg` (35°) meet at a corner, placed at their lines' intersection when that lies
@@ -259,11 +262,28 @@ fn split_chain(
         }
         if let Some(seg) = fit_line(&v[i..=j], &w[i..=j]) {
             if seg.length() >= cfg.min_segment_m {
-                if let Some(prev) = out.last().copied().filter(|_| out.len() > first_seg) {
-                    corner_between(&prev, &seg, cfg, corners);
-                }
-                if out.push(seg).is_err() {
-                    dropped += 1;
+                let prev = out.last().copied().filter(|_| out.len() > first_seg);
+                match prev {
+                    // The merge step of split-and-merge: a run split off by an outlier (a
+                    // ghost return, a mixed pixel) and its neighbour on the same line are one
+                    // wall again. Consecutive runs of one chain have no gap over
+                    // `chain_break_m` between their vertices, so a doorway never merges.
+                    Some(p) if collinear(&p, &seg, cfg) => {
+                        let last = out.len() - 1;
+                        out[last] = Segment {
+                            a: p.a,
+                            b: seg.b,
+                            support: p.support.saturating_add(seg.support),
+                        };
+                    }
+                    _ => {
+                        if let Some(p) = prev {
+                            corner_between(&p, &seg, cfg, corners);
+                        }
+                        if out.push(seg).is_err() {
+                            dropped += 1;
+                        }
+                    }
                 }
             }
         }
@@ -289,6 +309,15 @@ fn split_chain(
         corner_between(&a, &b, cfg, corners);
     }
     dropped
+}
+
+/// `true` when `b` continues `a`'s line: under 5° apart and `b`'s ends within twice the split
+/// tolerance of `a`'s line.
+fn collinear(a: &Segment, b: &Segment, cfg: &WallConfig) -> bool {
+    let turn = crate::geometry::wrap_angle(b.angle() - a.angle()).abs();
+    turn.to_degrees() < 5.0
+        && a.line_distance(b.a) <= 2.0 * cfg.split_tol_m
+        && a.line_distance(b.b) <= 2.0 * cfg.split_tol_m
 }
 
 fn corner_between(a: &Segment, b: &Segment, cfg: &WallConfig, corners: &mut Corners) {

@@ -32,4 +32,5 @@ pub mod picture;
 pub mod pose_eval;
 pub mod robot;
 pub mod scenario;
+pub mod scenes_a;
 pub mod world;

@@ -23,6 +23,11 @@ use crate::grid::Grid;
 
 /// Wall thickness, metres.
 pub const WALL_T: f32 = 0.1;
+/// Narrowest doorway, metres: the paper's door-frame rule looks for gaps of 0.9–1.4 m (a
+/// standard interior door's clear opening is about 0.8–0.9 m; wider ones are common in offices).
+pub const DOOR_WIDTH_MIN: f32 = 0.9;
+/// Widest doorway, metres.
+pub const DOOR_WIDTH_MAX: f32 = 1.3;
 /// Clearance kept between furniture footprints (room for the robot), metres.
 pub const CLEARANCE: f32 = 0.7;
 
@@ -588,7 +593,7 @@ impl World {
                     ]
                 };
                 let door = b.rng.random_bool(cfg.door_chance).then(|| {
-                    let width = b.rng.random_range(0.7..1.2f32);
+                    let width = b.rng.random_range(DOOR_WIDTH_MIN..DOOR_WIDTH_MAX);
                     // A doorway on an edge long enough for it.
                     let n = outline.len();
                     let mut e = b.rng.random_range(0..n);
@@ -610,7 +615,7 @@ impl World {
                 let w2 = b.rng.random_range(3.0..6.0f32);
                 let h2 = b.rng.random_range(3.0..6.0f32);
                 let len = b.rng.random_range(1.5..4.0f32);
-                let cw = b.rng.random_range(1.1..1.6f32);
+                let cw = b.rng.random_range(1.2..1.7f32);
                 let yc = b.rng.random_range(0.3..(h1.min(h2) - cw - 0.3));
                 let yb = 0.0;
                 let x2 = w1 + len;
@@ -633,7 +638,9 @@ impl World {
                 b.outline(&outline, None);
                 // Doorways: walls across the corridor at both ends, each with a gap.
                 for x in [w1, x2 - WALL_T] {
-                    let width = b.rng.random_range(0.7..(cw - 0.2).min(1.2));
+                    let width = b
+                        .rng
+                        .random_range(DOOR_WIDTH_MIN..(cw - 0.2).min(DOOR_WIDTH_MAX));
                     let g0 = b.rng.random_range(0.05..(cw - width - 0.05));
                     b.wall(p(x, yc), p(x, yc + cw), p(1.0, 0.0), Some((g0, g0 + width)));
                 }

@@ -1,0 +1,322 @@
+//! `umbra-lab`: the Method A model's workbench (host only; not flashed to a robot).
+//!
+//! * `umbra-lab forest-data --out models/data/forest-train.csv [--seed 1] [--scenes 300]`
+//!   runs Method A on training scenes of the simulator and writes one labelled row per
+//!   candidate (both feature frames).
+//! * `umbra-lab forest-train [--data …] [--out models/src/forest_tables.rs] [--frame object]`
+//!   fits the scaler and forest and writes the constant tables.
+//! * `umbra-lab eval-a [--seed 2] [--scenes 200] [--confusion docs/method-a-confusion.png]`
+//!   scores the compiled-in forest on held-out scenes (another seed: other worlds), with
+//!   `--compare-frames` training both frames from `--data` in memory and scoring each, and
+//!   `--merge-guards` scoring each merge guard alone.
+//!
+//! Regenerating the committed forest is the two commands `forest-data` and `forest-train` with
+//! their defaults; both are deterministic.
+
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+use clap::{Parser, Subcommand, ValueEnum};
+use firmware::eval_a::{self, Score, csv_header, rows_of};
+use indicatif::{ProgressBar, ProgressStyle};
+use models::train::{TrainConfig, emit_rust, read_csv, train};
+use perception::class::ObjectClass;
+use perception::features::{FeatureFrame, N_FEATURES};
+use perception::method_a::{Classifier, MethodA, MethodAConfig};
+use sim::scenes_a::{PoseSource, SceneConfig, run_scene};
+
+#[derive(Parser)]
+#[command(name = "umbra-lab", version, about = "umbra's Method A workbench")]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Clone, Copy, ValueEnum, PartialEq)]
+enum Frame {
+    Object,
+    Axis,
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+enum Pose {
+    Odometry,
+    Truth,
+}
+
+/// The regeneration command written into the tables' header.
+const TRAIN_CMD: &str = "cargo run --release -p umbra-firmware --bin umbra-lab -- forest-data && cargo run --release -p umbra-firmware --bin umbra-lab -- forest-train";
+
+#[derive(Subcommand)]
+enum Command {
+    /// Labelled candidates from training scenes, as CSV.
+    ForestData {
+        #[arg(long, default_value = "models/data/forest-train.csv")]
+        out: PathBuf,
+        #[arg(long, default_value_t = 1)]
+        seed: u64,
+        #[arg(long, default_value_t = 300)]
+        scenes: usize,
+        #[arg(long, value_enum, default_value = "odometry")]
+        pose: Pose,
+    },
+    /// Trains the forest and writes its tables.
+    ForestTrain {
+        #[arg(long, default_value = "models/data/forest-train.csv")]
+        data: PathBuf,
+        #[arg(long, default_value = "models/src/forest_tables.rs")]
+        out: PathBuf,
+        #[arg(long, value_enum, default_value = "object")]
+        frame: Frame,
+        #[arg(long, default_value_t = 1)]
+        seed: u64,
+        /// Deepest split level.
+        #[arg(long, default_value_t = TrainConfig::default().max_depth)]
+        depth: usize,
+        /// Trees.
+        #[arg(long, default_value_t = TrainConfig::default().trees)]
+        trees: usize,
+    },
+    /// Scores Method A on held-out scenes.
+    EvalA {
+        #[arg(long, default_value_t = 2)]
+        seed: u64,
+        #[arg(long, default_value_t = 200)]
+        scenes: usize,
+        #[arg(long, value_enum, default_value = "odometry")]
+        pose: Pose,
+        /// Write the confusion matrix here (PNG).
+        #[arg(long)]
+        confusion: Option<PathBuf>,
+        /// Train both feature frames from this data in memory and score each.
+        #[arg(long)]
+        compare_frames: bool,
+        /// Score with each merge guard alone and with none.
+        #[arg(long)]
+        merge_guards: bool,
+        #[arg(long, default_value = "models/data/forest-train.csv")]
+        data: PathBuf,
+    },
+}
+
+fn bar(n: usize, what: &str) -> ProgressBar {
+    let b = ProgressBar::new(n as u64);
+    b.set_style(
+        ProgressStyle::with_template("{msg} [{bar:40}] {pos}/{len} {elapsed}")
+            .unwrap_or_else(|_| ProgressStyle::default_bar()),
+    );
+    b.set_message(what.to_string());
+    b
+}
+
+struct Nobody;
+impl Classifier for Nobody {
+    fn classify(&self, _: &[f32; N_FEATURES]) -> (Option<ObjectClass>, f32) {
+        (None, 0.0)
+    }
+}
+
+fn scene_cfg(seed: u64, pose: Pose) -> SceneConfig {
+    SceneConfig {
+        seed,
+        pose: match pose {
+            Pose::Odometry => PoseSource::Odometry,
+            Pose::Truth => PoseSource::Truth,
+        },
+        ..SceneConfig::default()
+    }
+}
+
+fn run(cli: Cli) -> Result<(), String> {
+    match cli.command {
+        Command::ForestData {
+            out,
+            seed,
+            scenes,
+            pose,
+        } => {
+            let cfg = scene_cfg(seed, pose);
+            let mut method = Box::new(MethodA::new());
+            let mut text = csv_header();
+            text.push('\n');
+            let b = bar(scenes, "scenes");
+            let mut counts = std::collections::BTreeMap::new();
+            for i in 0..scenes {
+                run_scene(
+                    i,
+                    &cfg,
+                    &MethodAConfig::default(),
+                    &mut method,
+                    &Nobody,
+                    |v| {
+                        for r in rows_of(v) {
+                            *counts.entry(r.truth).or_insert(0usize) += 1;
+                            text.push_str(&r.csv());
+                            text.push('\n');
+                        }
+                    },
+                );
+                b.inc(1);
+            }
+            b.finish();
+            if let Some(dir) = out.parent() {
+                std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+            }
+            std::fs::write(&out, text).map_err(|e| format!("{}: {e}", out.display()))?;
+            println!("{}: {counts:?}", out.display());
+        }
+        Command::ForestTrain {
+            data,
+            out,
+            frame,
+            seed,
+            depth,
+            trees,
+        } => {
+            let text =
+                std::fs::read_to_string(&data).map_err(|e| format!("{}: {e}", data.display()))?;
+            let object = frame == Frame::Object;
+            let d = read_csv(&text, object).map_err(|e| format!("{}: {e}", data.display()))?;
+            let t = train(
+                &d,
+                &TrainConfig {
+                    seed,
+                    object_frame: object,
+                    max_depth: depth,
+                    trees,
+                    ..TrainConfig::default()
+                },
+            );
+            std::fs::write(&out, emit_rust(&t, TRAIN_CMD))
+                .map_err(|e| format!("{}: {e}", out.display()))?;
+            println!(
+                "{}: {} samples, {} trees, {} nodes",
+                out.display(),
+                d.x.len(),
+                t.roots.len(),
+                t.nodes.len()
+            );
+        }
+        Command::EvalA {
+            seed,
+            scenes,
+            pose,
+            confusion,
+            compare_frames,
+            merge_guards,
+            data,
+        } => {
+            let cfg = scene_cfg(seed, pose);
+            let forest = models::forest::forest();
+            let acfg = MethodAConfig {
+                frame: if forest.object_frame {
+                    FeatureFrame::Object
+                } else {
+                    FeatureFrame::Axis
+                },
+                ..MethodAConfig::default()
+            };
+            let go = |acfg: &MethodAConfig, c: &dyn Fn(&MethodAConfig, &ProgressBar) -> Score| {
+                let b = bar(scenes, "scenes");
+                let s = c(acfg, &b);
+                b.finish_and_clear();
+                s
+            };
+            let eval = |acfg: &MethodAConfig, classifier: &models::forest::ForestTables| {
+                go(acfg, &|a, b| {
+                    eval_a::evaluate(0..scenes, &cfg, a, classifier, || b.inc(1))
+                })
+            };
+            let score = eval(&acfg, forest);
+            println!(
+                "## Method A, held-out scenes (seed {seed}, {scenes} scenes, {} views)\n",
+                score.views
+            );
+            println!("{}", score.markdown());
+            if let Some(p) = confusion {
+                firmware::confusion_png::write(&p, &score)
+                    .map_err(|e| format!("{}: {e}", p.display()))?;
+                println!("confusion matrix: {}", p.display());
+            }
+            if compare_frames {
+                let text = std::fs::read_to_string(&data)
+                    .map_err(|e| format!("{}: {e}", data.display()))?;
+                for object in [true, false] {
+                    let d =
+                        read_csv(&text, object).map_err(|e| format!("{}: {e}", data.display()))?;
+                    let f = train(
+                        &d,
+                        &TrainConfig {
+                            object_frame: object,
+                            ..TrainConfig::default()
+                        },
+                    )
+                    .leak();
+                    let a = MethodAConfig {
+                        frame: if object {
+                            FeatureFrame::Object
+                        } else {
+                            FeatureFrame::Axis
+                        },
+                        ..MethodAConfig::default()
+                    };
+                    let s = eval(&a, &f);
+                    let (r, n) = s.object_accuracy();
+                    let f1: Vec<String> = s.prf().iter().map(|x| format!("{:.4}", x.2)).collect();
+                    println!(
+                        "frame {}: object accuracy {r}/{n} = {:.2} %, F1 chair/box/desk {}",
+                        if object { "object" } else { "axis" },
+                        100.0 * f64::from(r) / f64::from(n.max(1)),
+                        f1.join(" / ")
+                    );
+                }
+            }
+            if merge_guards {
+                let base = acfg.merge;
+                let variants = [
+                    ("no guard", false, false, false),
+                    ("legs only", true, false, false),
+                    ("solid only", false, true, false),
+                    ("extent only", false, false, true),
+                    ("all guards", true, true, true),
+                ];
+                println!(
+                    "\n| merge rule | candidates fusing distinct objects | split object-views | object accuracy | F1 chair / box / desk |\n|---|---|---|---|---|"
+                );
+                for (name, l, s, e) in variants {
+                    let a = MethodAConfig {
+                        merge: perception::merge::MergeConfig {
+                            guard_legs: l,
+                            guard_solid: s,
+                            guard_extent: e,
+                            ..base
+                        },
+                        ..acfg
+                    };
+                    let sc = eval(&a, forest);
+                    let (r, n) = sc.object_accuracy();
+                    let f1: Vec<String> = sc.prf().iter().map(|x| format!("{:.4}", x.2)).collect();
+                    println!(
+                        "| {name} | {} of {} | {} | {:.2} % | {} |",
+                        sc.fused,
+                        sc.candidates,
+                        sc.split,
+                        100.0 * f64::from(r) / f64::from(n.max(1)),
+                        f1.join(" / ")
+                    );
+                }
+            }
+        }
+    }
+    Ok(())
+}
+
+fn main() -> ExitCode {
+    match run(Cli::parse()) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("umbra-lab: {e}");
+            ExitCode::from(1)
+        }
+    }
+}
