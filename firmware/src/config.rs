@@ -27,6 +27,22 @@
 //! field_reference_ut = [20.1, -41.3]  # clean field at calibration (horizontal, vertical)
 //! offset_deg = 0.0             # magnetic declination + mount offset
 //! field_tolerance = 0.08       # accepted deviation of the horizontal field strength
+//!
+//! [method_a]                   # the geometric pipeline (docs/method-a.md)
+//! enabled = true
+//! drop_fraction = 0.05         # oldest share of the cloud dropped every revolution
+//! eps_min_m = 0.08             # adaptive DBSCAN radius bounds
+//! eps_max_m = 0.32
+//! min_samples = 10
+//! min_cluster_points = 20
+//! merge_link_m = 1.3           # fragment centroid within this of its object's centroid
+//! wall_area_m2 = 2.0
+//! wall_aspect = 4.0
+//! corner_min_deg = 35.0
+//! door_max_angle_deg = 10.0
+//! door_min_gap_m = 0.9
+//! door_max_gap_m = 1.4
+//! lidar_mount_x_m = -0.032     # LiDAR position on the robot (Burger)
 //! ```
 
 use std::fmt;
@@ -34,6 +50,7 @@ use std::path::{Path, PathBuf};
 
 use drivers::lds01::{AssemblerConfig, ChecksumPolicy, Lds01Config};
 use drivers::opencr::OpencrConfig;
+use perception::method_a::MethodAConfig;
 use perception::pose::{HeadingConfig, OdometryConfig, PoseFilter};
 use serde::Deserialize;
 
@@ -163,6 +180,65 @@ impl Default for CompassSettings {
     }
 }
 
+/// `[method_a]`: the geometric pipeline's main settings.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct MethodASettings {
+    /// Run Method A at all.
+    pub enabled: bool,
+    /// Share of the cloud dropped (oldest first) every revolution.
+    pub drop_fraction: f32,
+    /// Smallest DBSCAN radius, m.
+    pub eps_min_m: f32,
+    /// Largest DBSCAN radius, m.
+    pub eps_max_m: f32,
+    /// Neighbours of a core point.
+    pub min_samples: u16,
+    /// Smallest cluster kept.
+    pub min_cluster_points: u16,
+    /// Fragment merge distance, m.
+    pub merge_link_m: f32,
+    /// Wall area threshold, m².
+    pub wall_area_m2: f32,
+    /// Wall aspect threshold.
+    pub wall_aspect: f32,
+    /// Corner angle, degrees.
+    pub corner_min_deg: f32,
+    /// Door: largest angle between the two wall segments, degrees.
+    pub door_max_angle_deg: f32,
+    /// Door: narrowest gap, m.
+    pub door_min_gap_m: f32,
+    /// Door: widest gap, m.
+    pub door_max_gap_m: f32,
+    /// LiDAR position on the robot, forward, m.
+    pub lidar_mount_x_m: f32,
+    /// LiDAR position on the robot, left, m.
+    pub lidar_mount_y_m: f32,
+}
+
+impl Default for MethodASettings {
+    fn default() -> Self {
+        let d = MethodAConfig::default();
+        MethodASettings {
+            enabled: true,
+            drop_fraction: d.cloud.drop_fraction,
+            eps_min_m: d.dbscan.eps_min_m,
+            eps_max_m: d.dbscan.eps_max_m,
+            min_samples: d.dbscan.min_samples,
+            min_cluster_points: d.dbscan.min_cluster_points,
+            merge_link_m: d.merge.link_m,
+            wall_area_m2: d.walls.wall_area_m2,
+            wall_aspect: d.walls.wall_aspect,
+            corner_min_deg: d.walls.corner_min_deg,
+            door_max_angle_deg: d.doors.max_angle_deg,
+            door_min_gap_m: d.doors.min_gap_m,
+            door_max_gap_m: d.doors.max_gap_m,
+            lidar_mount_x_m: -0.032,
+            lidar_mount_y_m: 0.0,
+        }
+    }
+}
+
 /// The whole configuration.
 #[derive(Debug, Clone, PartialEq, Deserialize, Default)]
 #[serde(default, deny_unknown_fields)]
@@ -177,6 +253,8 @@ pub struct Config {
     pub opencr: OpencrSettings,
     /// Compass calibration and gates.
     pub compass: CompassSettings,
+    /// Method A.
+    pub method_a: MethodASettings,
 }
 
 /// A configuration error, naming the file and field.
@@ -231,6 +309,40 @@ impl Config {
                 l.stale_after_ms
             ));
         }
+        let a = &self.method_a;
+        let within = |name: &str, v: f32, lo: f32, hi: f32| {
+            if v.is_finite() && (lo..=hi).contains(&v) {
+                Ok(())
+            } else {
+                Err(format!(
+                    "method_a.{name} = {v}: must be within [{lo}, {hi}]"
+                ))
+            }
+        };
+        within("drop_fraction", a.drop_fraction, 0.0, 1.0)?;
+        within("eps_min_m", a.eps_min_m, 0.01, 2.0)?;
+        within("eps_max_m", a.eps_max_m, a.eps_min_m, 2.0)?;
+        within("merge_link_m", a.merge_link_m, 0.0, 5.0)?;
+        within("wall_area_m2", a.wall_area_m2, 0.0, 100.0)?;
+        within("wall_aspect", a.wall_aspect, 1.0, 1000.0)?;
+        within("corner_min_deg", a.corner_min_deg, 0.0, 90.0)?;
+        within("door_max_angle_deg", a.door_max_angle_deg, 0.0, 90.0)?;
+        within("door_min_gap_m", a.door_min_gap_m, 0.0, 10.0)?;
+        within("door_max_gap_m", a.door_max_gap_m, a.door_min_gap_m, 10.0)?;
+        within("lidar_mount_x_m", a.lidar_mount_x_m, -1.0, 1.0)?;
+        within("lidar_mount_y_m", a.lidar_mount_y_m, -1.0, 1.0)?;
+        if !(1..=1000).contains(&a.min_samples) {
+            return Err(format!(
+                "method_a.min_samples = {}: must be within 1..=1000",
+                a.min_samples
+            ));
+        }
+        if !(1..=8192).contains(&a.min_cluster_points) {
+            return Err(format!(
+                "method_a.min_cluster_points = {}: must be within 1..=8192",
+                a.min_cluster_points
+            ));
+        }
         let d = self.runtime.deadline_ms;
         if !(d.is_finite() && d > 0.0 && d <= 10_000.0) {
             return Err(format!(
@@ -261,6 +373,36 @@ impl Config {
             f.set_field_reference(r[0], r[1]);
         }
         f
+    }
+
+    /// The Method A pipeline settings (its range window is the LiDAR's).
+    pub fn method_a(&self) -> MethodAConfig {
+        let a = &self.method_a;
+        let mut c = MethodAConfig::default();
+        c.cloud.drop_fraction = a.drop_fraction;
+        c.cloud.range_min_m = self.lidar.min_range_m;
+        c.cloud.range_max_m = self.lidar.max_range_m;
+        c.dbscan.eps_min_m = a.eps_min_m;
+        c.dbscan.eps_max_m = a.eps_max_m;
+        c.dbscan.min_samples = a.min_samples;
+        c.dbscan.min_cluster_points = a.min_cluster_points;
+        c.merge.link_m = a.merge_link_m;
+        c.walls.wall_area_m2 = a.wall_area_m2;
+        c.walls.wall_aspect = a.wall_aspect;
+        c.walls.corner_min_deg = a.corner_min_deg;
+        c.doors.max_angle_deg = a.door_max_angle_deg;
+        c.doors.min_gap_m = a.door_min_gap_m;
+        c.doors.max_gap_m = a.door_max_gap_m;
+        c
+    }
+
+    /// The LiDAR's pose on the robot.
+    pub fn lidar_mount(&self) -> perception::geometry::Pose2 {
+        perception::geometry::Pose2::new(
+            self.method_a.lidar_mount_x_m,
+            self.method_a.lidar_mount_y_m,
+            0.0,
+        )
     }
 
     /// The OpenCR reader settings.
@@ -309,6 +451,14 @@ mod test {
         assert!(toml::from_str::<Config>("[lidar]\nmax_rnage_m = 4.2\n").is_err());
         let bad: Config = toml::from_str("[lidar]\nmin_range_m = 5.0\n").unwrap();
         assert!(bad.validate().unwrap_err().contains("lidar.max_range_m"));
+        let bad: Config = toml::from_str("[method_a]\ndoor_max_gap_m = 0.5\n").unwrap();
+        assert!(
+            bad.validate()
+                .unwrap_err()
+                .contains("method_a.door_max_gap_m")
+        );
+        let bad: Config = toml::from_str("[method_a]\neps_min_m = nan\n").unwrap();
+        assert!(bad.validate().unwrap_err().contains("method_a.eps_min_m"));
         let bad: Config = toml::from_str("[runtime]\ndeadline_ms = -1.0\n").unwrap();
         assert!(bad.validate().unwrap_err().contains("runtime.deadline_ms"));
     }

@@ -323,6 +323,10 @@ fn run_loop(
         stats,
         stop,
         pose,
+        method_a: cfg
+            .method_a
+            .enabled
+            .then(|| (cfg.method_a(), cfg.lidar_mount())),
     };
     let summary = runner::run(source, cfg.lds01(), opts)
         .map_err(|e| (EXIT_FAULT, format!("cannot write output: {e}")))?;

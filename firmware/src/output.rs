@@ -17,7 +17,7 @@ pub struct PoseOut {
     pub theta: f64,
 }
 
-/// A detected object (none yet: the recognition methods have not landed).
+/// A detected object.
 #[derive(Debug, Clone, Serialize, PartialEq)]
 pub struct ObjectOut {
     /// Track id.
@@ -67,6 +67,9 @@ pub struct TimingOut {
     pub ingest: f64,
     /// Feeding odometry and compass to the pose filter.
     pub pose: f64,
+    /// Method A, cloud update to labelled objects (absent when Method A is off).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub method_a: Option<f64>,
     /// Whole frame.
     pub total: f64,
 }
@@ -137,7 +140,7 @@ pub struct LidarOut {
 
 /// One output line (`interfaces.md` §3).
 #[derive(Debug, Clone, Serialize, PartialEq)]
-pub struct OutputLine {
+pub struct OutputLine<'a> {
     /// Frame number since start.
     pub frame: u64,
     /// Sensor-clock time of the frame's first ray, s.
@@ -145,11 +148,11 @@ pub struct OutputLine {
     /// Robot pose in the map frame.
     pub pose: PoseOut,
     /// Recognised objects.
-    pub objects: Vec<ObjectOut>,
+    pub objects: &'a [ObjectOut],
     /// Wall segments.
-    pub walls: Vec<WallOut>,
+    pub walls: &'a [WallOut],
     /// Doors.
-    pub doors: Vec<DoorOut>,
+    pub doors: &'a [DoorOut],
     /// Stage times.
     pub timing_ms: TimingOut,
     /// The per-frame budget.
@@ -166,7 +169,7 @@ pub struct OutputLine {
     pub lidar: LidarOut,
 }
 
-impl OutputLine {
+impl OutputLine<'_> {
     /// Writes the line and a newline.
     pub fn write_to(&self, w: &mut impl Write) -> io::Result<()> {
         serde_json::to_writer(&mut *w, self)?;
@@ -200,12 +203,13 @@ mod test {
             frame: 3,
             t: 0.6,
             pose: PoseOut::default(),
-            objects: vec![],
-            walls: vec![],
-            doors: vec![],
+            objects: &[],
+            walls: &[],
+            doors: &[],
             timing_ms: TimingOut {
                 ingest: 0.1,
                 pose: 0.0,
+                method_a: None,
                 total: 0.2,
             },
             deadline_ms: 250.0,

@@ -1,9 +1,11 @@
-//! The frame loop as it stands: ingest → output. One frame per LiDAR revolution.
+//! The frame loop as it stands: ingest → pose → Method A → output. One frame per LiDAR
+//! revolution.
 //!
 //! `timing_ms.ingest` is the time spent decoding the frame's bytes (not waiting for them).
 //! Bytes are read into one fixed buffer ([`READ_CHUNK`] bytes), fed to the LDS-01 stream,
 //! and each finished revolution becomes a frame: a statistics line, a JSON line, or both.
-//! Pose, Method A and Method B join this loop as their issues land.
+//! The pose is taken at the revolution's first and last ray (the first is the previous
+//! revolution's last), so Method A de-skews the scan. Method B joins as its issue lands.
 
 use std::io::Write;
 use std::sync::Arc;
@@ -13,13 +15,17 @@ use std::time::{Duration, Instant};
 use std::collections::VecDeque;
 
 use drivers::lds01::{Lds01Config, Lds01Faults, Lds01Stream};
-use perception::geometry::Pose2;
+use perception::cloud::Scan;
+use perception::geometry::{Point2, Pose2};
+use perception::method_a::{MethodA, MethodAConfig};
 
 use drivers::opencr::OpencrReader;
 
 use crate::odom::{OdomFile, OdomRecord, PoseState};
 
-use crate::output::{FaultsOut, LidarOut, OutputLine, PoseOut, TimingOut, stats_line};
+use crate::output::{
+    DoorOut, FaultsOut, LidarOut, ObjectOut, OutputLine, PoseOut, TimingOut, WallOut, stats_line,
+};
 use crate::source::{LidarSource, Pacing, SourceRead};
 
 /// Bytes read from the source at a time (~0.2 revolution; a capture is read in these too).
@@ -54,7 +60,23 @@ pub struct RunOptions {
     pub stop: Arc<AtomicBool>,
     /// Pose input; `None`: no odometry, the robot is assumed still.
     pub pose: Option<PoseInput>,
+    /// Method A settings and the LiDAR's pose on the robot; `None`: Method A off.
+    pub method_a: Option<(MethodAConfig, Pose2)>,
 }
+
+/// What the loop keeps between frames, allocated once at start-up.
+struct FrameState {
+    method_a: Box<MethodA>,
+    /// Robot pose at the last ray of the previous revolution.
+    last_end: Option<Pose2>,
+    ranges: [f32; drivers::lds01::READINGS_PER_REV],
+    objects: Vec<ObjectOut>,
+    walls: Vec<WallOut>,
+    doors: Vec<DoorOut>,
+}
+
+/// Output capacity reserved at start-up (so that the loop does not allocate).
+const OUT_CAPACITY: usize = perception::method_a::MAX_CANDIDATES + perception::doors::MAX_DOORS;
 
 /// Samples queued from a live source before the frame they belong to, at most (20 Hz encoders
 /// over 2 s; older ones are fed at once rather than dropped).
@@ -171,6 +193,14 @@ pub fn run(
     let start = Instant::now();
     let mut summary = Summary::default();
     let mut ingest = Duration::ZERO;
+    let mut state = FrameState {
+        method_a: Box::new(MethodA::new()),
+        last_end: None,
+        ranges: [0.0; drivers::lds01::READINGS_PER_REV],
+        objects: Vec::with_capacity(OUT_CAPACITY),
+        walls: Vec::with_capacity(perception::walls::MAX_SEGMENTS),
+        doors: Vec::with_capacity(perception::doors::MAX_DOORS),
+    };
 
     let reason = 'outer: loop {
         if opts.stop.load(Ordering::Relaxed) {
@@ -191,7 +221,14 @@ pub fn run(
             SourceRead::Idle => {
                 let now = host_us();
                 if stream.poll(now, |_| {})
-                    && emit_frame(&stream, source, &mut opts, &mut summary, &mut ingest)?
+                    && emit_frame(
+                        &stream,
+                        source,
+                        &mut opts,
+                        &mut summary,
+                        &mut ingest,
+                        &mut state,
+                    )?
                 {
                     break 'outer "frame limit";
                 }
@@ -199,7 +236,14 @@ pub fn run(
             }
             SourceRead::End => {
                 if stream.finish(|_| {}) {
-                    emit_frame(&stream, source, &mut opts, &mut summary, &mut ingest)?;
+                    emit_frame(
+                        &stream,
+                        source,
+                        &mut opts,
+                        &mut summary,
+                        &mut ingest,
+                        &mut state,
+                    )?;
                 }
                 break 'outer "end of input";
             }
@@ -226,7 +270,14 @@ pub fn run(
             if !done {
                 break;
             }
-            let limit = emit_frame(&stream, source, &mut opts, &mut summary, &mut ingest)?;
+            let limit = emit_frame(
+                &stream,
+                source,
+                &mut opts,
+                &mut summary,
+                &mut ingest,
+                &mut state,
+            )?;
             if limit {
                 break 'outer "frame limit";
             }
@@ -260,6 +311,7 @@ fn emit_frame(
     opts: &mut RunOptions,
     summary: &mut Summary,
     ingest: &mut Duration,
+    state: &mut FrameState,
 ) -> std::io::Result<bool> {
     let Some(rev) = stream.last_revolution() else {
         return Ok(false);
@@ -278,9 +330,16 @@ fn emit_frame(
     }
     let t = rev.first_ray_time_s().max(0.0);
     let t_pose = Instant::now();
-    let (pose, encoder_errors, compass_rejected, compass_errors) = match opts.pose.as_mut() {
+    // The last ray comes 359/360 of a revolution after the first.
+    let period = if rev.period_s.is_finite() && rev.period_s > 0.0 && rev.period_s < 2.0 {
+        f64::from(rev.period_s)
+    } else {
+        0.2
+    };
+    let t_end = t + period * 359.0 / 360.0;
+    let (end, encoder_errors, compass_rejected, compass_errors) = match opts.pose.as_mut() {
         Some(p) => {
-            let pose = p.advance(t);
+            let pose = p.advance(t_end);
             (
                 pose,
                 p.state.encoder_errors,
@@ -290,7 +349,73 @@ fn emit_frame(
         }
         None => (Pose2::IDENTITY, 0, 0, 0),
     };
+    let pose = state.last_end.unwrap_or(end);
+    state.last_end = Some(end);
     let pose_ms = t_pose.elapsed().as_secs_f64() * 1e3;
+    let t_a = Instant::now();
+    state.objects.clear();
+    state.walls.clear();
+    state.doors.clear();
+    let method_a_ms = match opts.method_a.as_ref() {
+        Some((cfg, mount)) => {
+            for (r, reading) in state.ranges.iter_mut().zip(rev.readings.iter()) {
+                *r = if reading.valid { reading.range_m } else { 0.0 };
+            }
+            let m = &mut state.method_a;
+            m.add_scan(
+                &Scan {
+                    ranges: &state.ranges,
+                    start: pose,
+                    end,
+                    mount: *mount,
+                },
+                cfg,
+            );
+            let sensor = end.compose(mount);
+            m.run(
+                Point2::new(sensor.x, sensor.y),
+                cfg,
+                models::forest::forest(),
+            );
+            for (k, (class, c)) in m.objects().enumerate() {
+                state.objects.push(ObjectOut {
+                    id: k as u32,
+                    class: class.as_str(),
+                    x: f64::from(c.centre.x),
+                    y: f64::from(c.centre.y),
+                    score: f64::from(c.score),
+                    source: "A",
+                });
+            }
+            for s in m.segments() {
+                state.walls.push(WallOut {
+                    x0: f64::from(s.a.x),
+                    y0: f64::from(s.a.y),
+                    x1: f64::from(s.b.x),
+                    y1: f64::from(s.b.y),
+                });
+            }
+            let base = state.objects.len();
+            for (k, d) in m.doors().iter().enumerate() {
+                state.doors.push(DoorOut {
+                    x: f64::from(d.centre.x),
+                    y: f64::from(d.centre.y),
+                    width: f64::from(d.width),
+                    score: f64::from(d.score),
+                });
+                state.objects.push(ObjectOut {
+                    id: (base + k) as u32,
+                    class: perception::class::ObjectClass::DoorFrame.as_str(),
+                    x: f64::from(d.centre.x),
+                    y: f64::from(d.centre.y),
+                    score: f64::from(d.score),
+                    source: "A",
+                });
+            }
+            Some(t_a.elapsed().as_secs_f64() * 1e3)
+        }
+        None => None,
+    };
     let ingest_ms = ingest.as_secs_f64() * 1e3;
     let total_ms = ingest_ms + t_frame.elapsed().as_secs_f64() * 1e3;
     let missed = total_ms > opts.deadline_ms;
@@ -306,12 +431,13 @@ fn emit_frame(
                 y: f64::from(pose.y),
                 theta: f64::from(pose.theta),
             },
-            objects: Vec::new(),
-            walls: Vec::new(),
-            doors: Vec::new(),
+            objects: &state.objects,
+            walls: &state.walls,
+            doors: &state.doors,
             timing_ms: TimingOut {
                 ingest: ingest_ms,
                 pose: pose_ms,
+                method_a: method_a_ms,
                 total: total_ms,
             },
             deadline_ms: opts.deadline_ms,

@@ -473,3 +473,76 @@ fn calibrate_compass_writes_the_config_that_run_uses() {
     assert_eq!(o.status.code(), Some(1));
     assert!(String::from_utf8_lossy(&o.stderr).contains("full turn"));
 }
+
+#[test]
+fn replay_of_a_simulated_recording_finds_its_true_objects() {
+    // Method A end to end: capture + odometry through `umbra replay`, objects scored against
+    // the recording's truth (same class within 0.3 m, `interfaces.md` §3).
+    let dir = tmp("method-a-ds");
+    let _ = std::fs::remove_dir_all(&dir);
+    let cfg = sim::dataset::DatasetConfig {
+        scenarios: 4,
+        frames: 60,
+        seed: 11,
+        method_b: false,
+        method_a: false,
+        pictures: 0,
+        ..sim::dataset::DatasetConfig::default()
+    };
+    sim::dataset::generate(&cfg, &dir, |_| {}).unwrap();
+    let (mut reported, mut right, mut with_walls, mut frames_seen) = (0, 0, 0, 0);
+    for s in 0..4 {
+        let rec = dir.join(format!("recordings/s{s:04}"));
+        let out = tmp(&format!("method-a-{s}.jsonl"));
+        let o = umbra(&[
+            "replay",
+            rec.join("capture.bin").to_str().unwrap(),
+            "--odom",
+            rec.join("odom.jsonl").to_str().unwrap(),
+            "--jsonl",
+            out.to_str().unwrap(),
+            "--quiet",
+        ]);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        let frames: Vec<Value> = std::fs::read_to_string(&out)
+            .unwrap()
+            .lines()
+            .map(|l| serde_json::from_str(l).unwrap())
+            .collect();
+        let truth: Vec<Value> = std::fs::read_to_string(rec.join("truth.jsonl"))
+            .unwrap()
+            .lines()
+            .map(|l| serde_json::from_str(l).unwrap())
+            .collect();
+        let f = |v: &Value| v.as_f64().unwrap();
+        for (frame, t) in frames.iter().zip(&truth).skip(30) {
+            frames_seen += 1;
+            if !frame["walls"].as_array().unwrap().is_empty() {
+                with_walls += 1;
+            }
+            for o in frame["objects"].as_array().unwrap() {
+                if o["class"] == "door_frame" {
+                    continue;
+                }
+                reported += 1;
+                let hit = t["objects"].as_array().unwrap().iter().any(|g| {
+                    g["class"] == o["class"]
+                        && (f(&g["x"]) - f(&o["x"])).hypot(f(&g["y"]) - f(&o["y"])) <= 0.3
+                });
+                right += usize::from(hit);
+            }
+        }
+    }
+    eprintln!(
+        "method A replay: {right}/{reported} reported objects right, walls in {with_walls}/{frames_seen} frames"
+    );
+    assert!(
+        with_walls * 10 >= frames_seen * 9,
+        "{with_walls}/{frames_seen} frames with walls"
+    );
+    assert!(reported >= 40, "only {reported} objects reported");
+    assert!(
+        right * 10 >= reported * 8,
+        "{right}/{reported} reported objects match a true object of their class"
+    );
+}

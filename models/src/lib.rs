@@ -15,6 +15,7 @@
 pub use perception::class::ObjectClass;
 
 pub mod forest;
+#[rustfmt::skip]
 pub mod forest_tables;
 #[cfg(feature = "std")]
 pub mod train;
