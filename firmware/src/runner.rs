@@ -4,8 +4,8 @@
 //! `timing_ms.ingest` is the time spent decoding the frame's bytes (not waiting for them).
 //! Bytes are read into one fixed buffer ([`READ_CHUNK`] bytes), fed to the LDS-01 stream,
 //! and each finished revolution becomes a frame: a statistics line, a JSON line, or both.
-//! The pose is taken at the revolution's first and last ray (the first is the previous
-//! revolution's last), so Method A de-skews the scan. Method B joins as its issue lands.
+//! The pose is taken at the revolution's first ray (the output line's pose) and at its last,
+//! so Method A de-skews the scan. Method B joins as its issue lands.
 
 use std::io::Write;
 use std::sync::Arc;
@@ -67,8 +67,6 @@ pub struct RunOptions {
 /// What the loop keeps between frames, allocated once at start-up.
 struct FrameState {
     method_a: Box<MethodA>,
-    /// Robot pose at the last ray of the previous revolution.
-    last_end: Option<Pose2>,
     ranges: [f32; drivers::lds01::READINGS_PER_REV],
     objects: Vec<ObjectOut>,
     walls: Vec<WallOut>,
@@ -195,7 +193,6 @@ pub fn run(
     let mut ingest = Duration::ZERO;
     let mut state = FrameState {
         method_a: Box::new(MethodA::new()),
-        last_end: None,
         ranges: [0.0; drivers::lds01::READINGS_PER_REV],
         objects: Vec::with_capacity(OUT_CAPACITY),
         walls: Vec::with_capacity(perception::walls::MAX_SEGMENTS),
@@ -337,20 +334,20 @@ fn emit_frame(
         0.2
     };
     let t_end = t + period * 359.0 / 360.0;
-    let (end, encoder_errors, compass_rejected, compass_errors) = match opts.pose.as_mut() {
+    let (pose, end, encoder_errors, compass_rejected, compass_errors) = match opts.pose.as_mut() {
         Some(p) => {
-            let pose = p.advance(t_end);
+            let start = p.advance(t);
+            let end = p.advance(t_end);
             (
-                pose,
+                start,
+                end,
                 p.state.encoder_errors,
                 u64::from(p.state.filter.compass_rejected()),
                 p.compass_errors,
             )
         }
-        None => (Pose2::IDENTITY, 0, 0, 0),
+        None => (Pose2::IDENTITY, Pose2::IDENTITY, 0, 0, 0),
     };
-    let pose = state.last_end.unwrap_or(end);
-    state.last_end = Some(end);
     let pose_ms = t_pose.elapsed().as_secs_f64() * 1e3;
     let t_a = Instant::now();
     state.objects.clear();
