@@ -1,0 +1,134 @@
+//! Method A speed: one full scene at ~7,200 points, cloud update to labelled objects, and the
+//! adaptive DBSCAN alone; with scikit-learn's DBSCAN on the same points as the peer
+//! (`bench/dbscan_peer.py`, run in the same process tree when python3 with scikit-learn is
+//! there; the ratios are printed).
+//!
+//! `cargo bench -p umbra-bench --bench method_a`
+
+use std::hint::black_box;
+use std::time::Instant;
+
+use criterion::{Criterion, criterion_group, criterion_main};
+use perception::geometry::Point2;
+use perception::method_a::{MethodA, MethodAConfig};
+use sim::scenes_a::{PoseSource, SceneConfig, run_scene};
+
+/// Scene 0 of seed 2 (an oscillating robot in a held-out room) after 40 revolutions.
+fn scene() -> (Box<MethodA>, Point2) {
+    let cfg = SceneConfig {
+        seed: 2,
+        frames: 40,
+        first: 39,
+        every: 1,
+        pose: PoseSource::Odometry,
+        ..SceneConfig::default()
+    };
+    let mut m = Box::new(MethodA::new());
+    let mut sensor = Point2::default();
+    run_scene(
+        0,
+        &cfg,
+        &MethodAConfig::default(),
+        &mut m,
+        models::forest::forest(),
+        |v| {
+            sensor = v.sensor;
+        },
+    );
+    (m, sensor)
+}
+
+fn peer_ms(points: &[Point2]) -> Option<f64> {
+    let path = std::env::temp_dir().join("umbra-method-a-cloud.csv");
+    let text: String = points
+        .iter()
+        .map(|p| format!("{},{}\n", p.x, p.y))
+        .collect();
+    std::fs::write(&path, text).ok()?;
+    let script = concat!(env!("CARGO_MANIFEST_DIR"), "/dbscan_peer.py");
+    let out = std::process::Command::new("python3")
+        .arg(script)
+        .arg(&path)
+        .output()
+        .ok()?;
+    let s = String::from_utf8_lossy(&out.stdout);
+    println!("peer: {}", s.trim());
+    s.split_whitespace().nth(1)?.parse().ok()
+}
+
+fn bench(c: &mut Criterion) {
+    let (base, sensor) = scene();
+    let cfg = MethodAConfig::default();
+    let points: Vec<Point2> = base.cloud().iter().copied().collect();
+    println!(
+        "scene: {} cloud points, {} candidates, {} segments, {} doors",
+        points.len(),
+        base.candidates().len(),
+        base.segments().len(),
+        base.doors().len()
+    );
+    let forest = models::forest::forest();
+    let mut g = c.benchmark_group("method_a");
+    // The whole frame: add a revolution's worth of points (age + insert), then run.
+    let ranges = [2.0f32; 360];
+    let mut m = base.clone();
+    g.bench_function("full_frame_7200", |b| {
+        b.iter(|| {
+            m.add_scan(
+                &perception::cloud::Scan {
+                    ranges: black_box(&ranges),
+                    start: perception::geometry::Pose2::IDENTITY,
+                    end: perception::geometry::Pose2::IDENTITY,
+                    mount: perception::geometry::Pose2::IDENTITY,
+                },
+                &MethodAConfig {
+                    cloud: perception::cloud::CloudConfig {
+                        drop_fraction: 0.0,
+                        ..cfg.cloud
+                    },
+                    ..cfg
+                },
+            );
+            m.run(sensor, &cfg, forest);
+            // Back to the same cloud for the next iteration.
+            m.clone_from(&base);
+        })
+    });
+    let mut d = Box::new(perception::dbscan::Dbscan::new());
+    g.bench_function("dbscan_7200", |b| {
+        b.iter(|| d.run(black_box(&points), &cfg.dbscan))
+    });
+    let mut copy = base.clone();
+    g.bench_function("clone_state_for_reference", |b| {
+        b.iter(|| copy.clone_from(&base))
+    });
+    g.finish();
+
+    // Ratios against the peer, timed here with the same points.
+    let time = |f: &mut dyn FnMut()| {
+        let mut v: Vec<f64> = (0..200)
+            .map(|_| {
+                let t = Instant::now();
+                f();
+                t.elapsed().as_secs_f64() * 1e3
+            })
+            .collect();
+        v.sort_by(f64::total_cmp);
+        v[v.len() / 2]
+    };
+    let mut m2 = base.clone();
+    let ours_full = time(&mut || m2.run(sensor, &cfg, forest));
+    let ours_dbscan = time(&mut || d.run(&points, &cfg.dbscan));
+    println!("ours: pipeline run {ours_full:.4} ms, DBSCAN {ours_dbscan:.4} ms (medians of 200)");
+    match peer_ms(&points) {
+        Some(p) => println!(
+            "ratio to scikit-learn DBSCAN ({p:.4} ms): pipeline {:.4}, DBSCAN {:.4}",
+            ours_full / p,
+            ours_dbscan / p
+        ),
+        None => println!("peer not run: python3 with scikit-learn not found"),
+    }
+}
+
+criterion_group!(benches, bench);
+criterion_main!(benches);
