@@ -3,15 +3,15 @@
 //! # The ε rule
 //!
 //! Each point gets its own radius from the density around it. The plane is cut into square
-//! cells of side `c` (ε_min, 0.08 m, unless the cloud is too wide for [`GRID_CELLS`], then
-//! larger); `n` is the number of points in the 3 × 3 cells around the point's cell. LiDAR
-//! points lie on curves (wall lines, the arcs of legs), so the block holds a line of length
-//! about `3c` and the spacing along it is `s = 3c / n`. A point on a line with spacing `s` has
-//! `2ε / s` neighbours within ε; `min_samples` of them need `ε ≥ min_samples · s / 2`. The rule
-//! takes twice that, for margin against gaps:
+//! cells of side `c = ε_min / √2` (0.057 m; larger if the cloud is too wide for
+//! [`GRID_CELLS`]); `n` is the number of points in the 5 × 5 cells around the point's cell, a
+//! box of side `L = 5c` (0.28 m). LiDAR points lie on curves (wall lines, the arcs of legs), so
+//! the block holds a line of length about `L` and the spacing along it is `s = L / n`. A point
+//! on a line with spacing `s` has `2ε / s` neighbours within ε; `min_samples` of them need
+//! `ε ≥ min_samples · s / 2`. The rule takes twice that, for margin against gaps:
 //!
 //! ```text
-//! ε_i = clamp(min_samples · 3c / n_i, ε_min, ε_max)        (0.08 m, 0.32 m by default)
+//! ε_i = clamp(min_samples · L / n_i, ε_min, ε_max)        (0.08 m, 0.32 m by default)
 //! ```
 //!
 //! Why: a wall seen from far away, or only on a few revolutions, is sampled sparsely, and a
@@ -34,16 +34,21 @@
 //!
 //! # Cost and capacities
 //!
-//! Points are bucketed by a counting sort into cells (no hashing), and a neighbourhood scan
-//! visits `(2⌈ε_i / c⌉ + 1)²` cells: 9 in dense regions. At most [`MAX_CLUSTERS`] clusters are
-//! kept (the largest ones by first appearance, in cell order); more are counted in
+//! Points are bucketed by a counting sort into cells (no hashing). Any two points of one cell
+//! are within ε_min, so a cell holding `min_samples` points is all core points in one set
+//! without a distance computed (the grid DBSCAN of Gunawan, 2013). Two cells' sets are joined
+//! at the first core pair within reach, and a pair of cells already in one set is skipped, so
+//! a dense wall costs one union per neighbouring cell instead of a scan per point. Sparse cells
+//! count neighbours point by point over `(2⌈ε_i / c⌉ + 1)²` cells. At most [`MAX_CLUSTERS`]
+//! clusters are kept (in cell order); more are counted in
 //! [`DbscanStats::clusters_over_capacity`].
 
 use crate::cloud::CLOUD_CAPACITY;
 use crate::geometry::Point2;
 
-/// Grid cells at most (128 × 128 at 0.08 m covers 10.24 m square; wider clouds get larger cells).
-pub const GRID_CELLS: usize = 16_384;
+/// Grid cells at most (256 × 256 cells of 0.057 m cover 14.5 m square; wider clouds get
+/// larger cells, which is slower but still exact).
+pub const GRID_CELLS: usize = 65_536;
 /// Clusters kept at most per run.
 pub const MAX_CLUSTERS: usize = 128;
 
@@ -58,7 +63,7 @@ pub const NOISE: u16 = u16::MAX;
 #[derive(Debug, Clone, Copy, PartialEq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct DbscanConfig {
-    /// Smallest ε, metres (also the grid cell side).
+    /// Smallest ε, metres (the grid cell side is ε_min / √2).
     pub eps_min_m: f32,
     /// Largest ε, metres.
     pub eps_max_m: f32,
@@ -262,7 +267,8 @@ impl Dbscan {
         }
 
         // Grid: cells of eps_min, grown until the bounds fit.
-        let mut cell = eps_min;
+        // Cells of ε_min / √2: any two points in one cell are within ε_min of each other.
+        let mut cell = eps_min * core::f32::consts::FRAC_1_SQRT_2;
         let dims = |cell: f32| {
             (
                 ((hi.x - lo.x) / cell) as usize + 1,
@@ -310,8 +316,9 @@ impl Dbscan {
         let cell_range =
             |cx: usize, cy: usize| starts[cy * nx + cx] as usize..starts[cy * nx + cx + 1] as usize;
 
-        // ε per point from the 3 × 3 block count.
+        // ε per cell from the 5 × 5 block count (every point of a cell shares it).
         let min_samples = cfg.min_samples.max(1) as usize;
+        let span = 5.0 * cell;
         for cy in 0..ny {
             for cx in 0..nx {
                 let own = cell_range(cx, cy);
@@ -319,68 +326,122 @@ impl Dbscan {
                     continue;
                 }
                 let mut count = 0usize;
-                for y in cy.saturating_sub(1)..=(cy + 1).min(ny - 1) {
-                    for x in cx.saturating_sub(1)..=(cx + 1).min(nx - 1) {
+                for y in cy.saturating_sub(2)..=(cy + 2).min(ny - 1) {
+                    for x in cx.saturating_sub(2)..=(cx + 2).min(nx - 1) {
                         count += cell_range(x, y).len();
                     }
                 }
-                let e = (min_samples as f32 * 3.0 * cell / count as f32).clamp(eps_min, eps_max);
+                let e = (min_samples as f32 * span / count as f32).clamp(eps_min, eps_max);
                 self.eps[own].fill(e);
             }
         }
 
-        // Core points.
+        // Neighbours of point i: every j with |p_i − p_j| ≤ min(ε_i, ε_j), found by scanning
+        // the cells within ε_i; `f` returns false to stop.
         let sorted = &self.sorted;
+        let eps = &self.eps;
+        let reach = |e: f32| (libm::ceilf(e / cell - 1e-4) as usize).max(1);
         let scan = |i: usize, f: &mut dyn FnMut(usize) -> bool| {
             let p = sorted[i];
-            let e = self.eps[i];
-            let r = libm::ceilf(e / cell) as usize;
+            let e = eps[i];
+            let r = reach(e);
             let (cx, cy) = grid.cell_xy(p);
-            let e2 = e * e;
             for y in cy.saturating_sub(r)..=(cy + r).min(ny - 1) {
                 for x in cx.saturating_sub(r)..=(cx + r).min(nx - 1) {
                     for j in cell_range(x, y) {
                         let d = sorted[j] - p;
-                        let ej = self.eps[j];
-                        let d2 = d.x * d.x + d.y * d.y;
-                        if d2 <= e2 && d2 <= ej * ej && !f(j) {
+                        let m = e.min(eps[j]);
+                        if d.x * d.x + d.y * d.y <= m * m && !f(j) {
                             return;
                         }
                     }
                 }
             }
         };
-        for i in 0..n {
-            let mut count = 0usize;
-            scan(i, &mut |_| {
-                count += 1;
-                count < min_samples
-            });
-            self.core[i] = count >= min_samples;
+
+        // Core points. Any two points of one cell are within ε_min (the cell's diagonal), so a
+        // cell holding min_samples points is all core without a scan.
+        for cy in 0..ny {
+            for cx in 0..nx {
+                let own = cell_range(cx, cy);
+                if own.len() >= min_samples {
+                    self.core[own].fill(true);
+                    continue;
+                }
+                for i in own {
+                    let mut count = 0usize;
+                    scan(i, &mut |_| {
+                        count += 1;
+                        count < min_samples
+                    });
+                    self.core[i] = count >= min_samples;
+                }
+            }
         }
 
-        // Union of core points; border points to their first core.
+        // Union of core points, cell by cell: a cell's core points are one set (within ε_min of
+        // each other); two cells' sets join at the first core pair within reach, and a pair of
+        // cells already in one set is not scanned at all.
         for i in 0..n {
             self.parent[i] = if self.core[i] { i as u16 } else { NOISE };
         }
-        for i in 0..n {
-            if !self.core[i] {
+        let core = &self.core;
+        let parent = &mut self.parent;
+        for cy in 0..ny {
+            for cx in 0..nx {
+                let own = cell_range(cx, cy);
+                let Some(rep) = own.clone().find(|&i| core[i]) else {
+                    continue;
+                };
+                for i in own.clone().filter(|&i| core[i] && i != rep) {
+                    parent[i] = rep as u16;
+                }
+                let e = eps[rep];
+                let r = reach(e);
+                let here = cy * nx + cx;
+                for y in cy.saturating_sub(r)..=(cy + r).min(ny - 1) {
+                    for x in cx.saturating_sub(r)..=(cx + r).min(nx - 1) {
+                        if y * nx + x <= here {
+                            continue;
+                        }
+                        let other = cell_range(x, y);
+                        let Some(rep_b) = other.clone().find(|&j| core[j]) else {
+                            continue;
+                        };
+                        if find(parent, rep) == find(parent, rep_b) {
+                            continue;
+                        }
+                        let m = e.min(eps[rep_b]);
+                        let linked = own.clone().filter(|&i| core[i]).any(|i| {
+                            other.clone().filter(|&j| core[j]).any(|j| {
+                                let d = sorted[j] - sorted[i];
+                                d.x * d.x + d.y * d.y <= m * m
+                            })
+                        });
+                        if linked {
+                            let (a, b) = (find(parent, rep), find(parent, rep_b));
+                            let (lo, hi) = if a < b { (a, b) } else { (b, a) };
+                            parent[hi] = lo as u16;
+                        }
+                    }
+                }
+            }
+        }
+        // Border points: owned by the first core neighbour found.
+        for j in 0..n {
+            if core[j] {
                 continue;
             }
-            let core = &self.core;
-            let parent = &mut self.parent;
-            scan(i, &mut |j| {
-                if core[j] {
-                    let (a, b) = (find(parent, i), find(parent, j));
-                    if a != b {
-                        let (lo, hi) = if a < b { (a, b) } else { (b, a) };
-                        parent[hi] = lo as u16;
-                    }
-                } else if parent[j] == NOISE {
-                    parent[j] = i as u16;
+            let mut owner = NOISE;
+            scan(j, &mut |i| {
+                if core[i] {
+                    owner = i as u16;
+                    false
+                } else {
+                    true
                 }
-                true
             });
+            parent[j] = owner;
         }
 
         // Roots → sizes (in `label`, per root), then cluster ids.
@@ -606,7 +667,7 @@ mod test {
         assert!(d.clusters().is_empty());
         // Capacity-many distinct points in a grid pattern.
         let grid: std::vec::Vec<_> = (0..CLOUD_CAPACITY)
-            .map(|i| Point2::new((i % 91) as f32 * 0.05, (i / 91) as f32 * 0.05))
+            .map(|i| Point2::new((i % 91) as f32 * 0.03, (i / 91) as f32 * 0.03))
             .collect();
         d.run(&grid, &cfg);
         assert_eq!(d.clusters().len(), 1);

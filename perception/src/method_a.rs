@@ -1,7 +1,7 @@
 //! Method A, the geometric pipeline, end to end: cloud → adaptive DBSCAN → walls, segments,
 //! corners → fragment merge → features → classifier → objects; door frames from the segments.
 //!
-//! [`MethodA`] owns every buffer the pipeline needs (about 330 kB, listed in
+//! [`MethodA`] owns every buffer the pipeline needs (about 430 kB, listed in
 //! `memory-budget.md`); [`MethodA::run`] allocates nothing. The classifier is a parameter
 //! ([`Classifier`]): the compiled-in forest lives in `models`, which depends on this crate.
 

@@ -18,6 +18,7 @@
 //! | [`noise`]     | the bounded, unit-σ noise every sensor model draws from               |
 //! | [`picture`]   | a PNG of a scene for people to look at                                |
 //! | [`pose_eval`] | drift of odometry, compass overwrite and our fusion on the simulator   |
+//! | [`scenes_a`]  | Method A run on simulated scenes, with truth labels for training and scoring |
 //! | [`corrupt`]   | a noisy serial line: bit flips, inserted and dropped bytes, with truth |
 #![deny(unsafe_code, missing_docs)]
 

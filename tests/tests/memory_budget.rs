@@ -10,6 +10,12 @@ use drivers::lds01::assembler::ASSEMBLER_REVOLUTIONS;
 use drivers::lds01::decoder::DECODER_BUFFER_LEN;
 use drivers::lds01::{Lds01Stream, READINGS_PER_REV, Reading, Revolution};
 use firmware::runner::READ_CHUNK;
+use perception::cloud::{CLOUD_CAPACITY, GlobalCloud};
+use perception::dbscan::{Dbscan, GRID_CELLS, MAX_CLUSTERS};
+use perception::doors::{Door, MAX_DOORS};
+use perception::geometry::Point2;
+use perception::method_a::{Candidate, MAX_CANDIDATES, MethodA};
+use perception::walls::{BEARING_BINS, MAX_CORNERS, MAX_SEGMENTS, Segment, WallScratch};
 
 /// (constant path as written in the table, capacity, element bytes), read from the code.
 fn buffers_in_code() -> Vec<(&'static str, usize, usize)> {
@@ -40,6 +46,57 @@ fn buffers_in_code() -> Vec<(&'static str, usize, usize)> {
             "size_of::<drivers::dynamixel::StatusDecoder>()",
             1,
             size_of::<StatusDecoder>(),
+        ),
+        (
+            "perception::cloud::CLOUD_CAPACITY",
+            CLOUD_CAPACITY,
+            size_of::<Point2>(),
+        ),
+        (
+            "size_of::<perception::cloud::GlobalCloud>()",
+            1,
+            size_of::<GlobalCloud>(),
+        ),
+        (
+            "perception::dbscan::GRID_CELLS",
+            GRID_CELLS + 1,
+            size_of::<u16>(),
+        ),
+        (
+            "perception::dbscan::MAX_CLUSTERS",
+            MAX_CLUSTERS,
+            size_of::<perception::dbscan::Cluster>(),
+        ),
+        (
+            "size_of::<perception::dbscan::Dbscan>()",
+            1,
+            size_of::<Dbscan>(),
+        ),
+        (
+            "perception::walls::BEARING_BINS",
+            BEARING_BINS,
+            size_of::<WallScratch>() / BEARING_BINS,
+        ),
+        (
+            "perception::walls::MAX_SEGMENTS",
+            MAX_SEGMENTS,
+            size_of::<Segment>(),
+        ),
+        (
+            "perception::walls::MAX_CORNERS",
+            MAX_CORNERS,
+            size_of::<Point2>(),
+        ),
+        ("perception::doors::MAX_DOORS", MAX_DOORS, size_of::<Door>()),
+        (
+            "perception::method_a::MAX_CANDIDATES",
+            MAX_CANDIDATES,
+            size_of::<Candidate>(),
+        ),
+        (
+            "size_of::<perception::method_a::MethodA>()",
+            1,
+            size_of::<MethodA>(),
         ),
     ]
 }
