@@ -98,6 +98,7 @@ pub struct MergeStats {
 }
 
 /// Merges `frags`; writes each fragment's group (0..n) to `group` and returns n.
+#[allow(clippy::needless_range_loop)] // a and b index four parallel arrays
 pub fn merge(
     frags: &[Fragment],
     cfg: &MergeConfig,

@@ -260,29 +260,29 @@ fn split_chain(
         if j + 1 - i < MIN_RUN_VERTICES {
             continue;
         }
-        if let Some(seg) = fit_line(&v[i..=j], &w[i..=j]) {
-            if seg.length() >= cfg.min_segment_m {
-                let prev = out.last().copied().filter(|_| out.len() > first_seg);
-                match prev {
-                    // The merge step of split-and-merge: a run split off by an outlier (a
-                    // ghost return, a mixed pixel) and its neighbour on the same line are one
-                    // wall again. Consecutive runs of one chain have no gap over
-                    // `chain_break_m` between their vertices, so a doorway never merges.
-                    Some(p) if collinear(&p, &seg, cfg) => {
-                        let last = out.len() - 1;
-                        out[last] = Segment {
-                            a: p.a,
-                            b: seg.b,
-                            support: p.support.saturating_add(seg.support),
-                        };
+        if let Some(seg) = fit_line(&v[i..=j], &w[i..=j])
+            && seg.length() >= cfg.min_segment_m
+        {
+            let prev = out.last().copied().filter(|_| out.len() > first_seg);
+            match prev {
+                // The merge step of split-and-merge: a run split off by an outlier (a
+                // ghost return, a mixed pixel) and its neighbour on the same line are one
+                // wall again. Consecutive runs of one chain have no gap over
+                // `chain_break_m` between their vertices, so a doorway never merges.
+                Some(p) if collinear(&p, &seg, cfg) => {
+                    let last = out.len() - 1;
+                    out[last] = Segment {
+                        a: p.a,
+                        b: seg.b,
+                        support: p.support.saturating_add(seg.support),
+                    };
+                }
+                _ => {
+                    if let Some(p) = prev {
+                        corner_between(&p, &seg, cfg, corners);
                     }
-                    _ => {
-                        if let Some(p) = prev {
-                            corner_between(&p, &seg, cfg, corners);
-                        }
-                        if out.push(seg).is_err() {
-                            dropped += 1;
-                        }
+                    if out.push(seg).is_err() {
+                        dropped += 1;
                     }
                 }
             }

@@ -64,7 +64,7 @@ fn method_a_frames_allocate_nothing() {
     let forest = models::forest::forest();
     let mut m = Box::new(MethodA::new());
     // Warm-up: fills the cloud.
-    let mut step = |m: &mut MethodA, (r, a, b): &([f32; 360], Pose2, Pose2)| {
+    let step = |m: &mut MethodA, (r, a, b): &([f32; 360], Pose2, Pose2)| {
         m.add_scan(
             &Scan {
                 ranges: r,
