@@ -100,8 +100,9 @@ pub struct PoseInput {
 pub type CompassReader = Box<dyn FnMut() -> Result<[f32; 3], String>>;
 
 impl PoseInput {
-    /// Feeds every sample up to sensor time `t` and returns the pose.
-    fn advance(&mut self, t: f64) -> Pose2 {
+    /// Reads the OpenCR and the compass once (a frame's device I/O) and feeds what they gave,
+    /// stamped at sensor time `t`.
+    fn poll_devices(&mut self, t: f64) {
         if let Some(board) = self.opencr.as_mut() {
             match board.poll() {
                 Ok((l, r)) => self.state.feed(&OdomRecord {
@@ -134,6 +135,10 @@ impl PoseInput {
                 }
             }
         }
+    }
+
+    /// Feeds every file or queued sample up to sensor time `t` and returns the pose at `t`.
+    fn advance(&mut self, t: f64) -> Pose2 {
         if let Some(f) = self.file.as_mut() {
             f.advance(t, &mut self.state);
         }
@@ -300,6 +305,23 @@ pub fn run(
     Ok(summary)
 }
 
+/// A Method A object of the output line; `id` is its place in the line.
+fn object_a(
+    id: usize,
+    class: perception::class::ObjectClass,
+    centre: Point2,
+    score: f32,
+) -> ObjectOut {
+    ObjectOut {
+        id: id as u32,
+        class: class.as_str(),
+        x: f64::from(centre.x),
+        y: f64::from(centre.y),
+        score: f64::from(score),
+        source: "A",
+    }
+}
+
 /// Writes the stream's last finished revolution as one frame; returns `true` when the frame
 /// limit is reached.
 fn emit_frame(
@@ -336,6 +358,7 @@ fn emit_frame(
     let t_end = t + period * 359.0 / 360.0;
     let (pose, end, encoder_errors, compass_rejected, compass_errors) = match opts.pose.as_mut() {
         Some(p) => {
+            p.poll_devices(t);
             let start = p.advance(t);
             let end = p.advance(t_end);
             (
@@ -374,15 +397,10 @@ fn emit_frame(
                 cfg,
                 models::forest::forest(),
             );
-            for (k, (class, c)) in m.objects().enumerate() {
-                state.objects.push(ObjectOut {
-                    id: k as u32,
-                    class: class.as_str(),
-                    x: f64::from(c.centre.x),
-                    y: f64::from(c.centre.y),
-                    score: f64::from(c.score),
-                    source: "A",
-                });
+            for (class, c) in m.objects() {
+                state
+                    .objects
+                    .push(object_a(state.objects.len(), class, c.centre, c.score));
             }
             for s in m.segments() {
                 state.walls.push(WallOut {
@@ -392,22 +410,19 @@ fn emit_frame(
                     y1: f64::from(s.b.y),
                 });
             }
-            let base = state.objects.len();
-            for (k, d) in m.doors().iter().enumerate() {
+            for d in m.doors() {
                 state.doors.push(DoorOut {
                     x: f64::from(d.centre.x),
                     y: f64::from(d.centre.y),
                     width: f64::from(d.width),
                     score: f64::from(d.score),
                 });
-                state.objects.push(ObjectOut {
-                    id: (base + k) as u32,
-                    class: perception::class::ObjectClass::DoorFrame.as_str(),
-                    x: f64::from(d.centre.x),
-                    y: f64::from(d.centre.y),
-                    score: f64::from(d.score),
-                    source: "A",
-                });
+                state.objects.push(object_a(
+                    state.objects.len(),
+                    perception::class::ObjectClass::DoorFrame,
+                    d.centre,
+                    d.score,
+                ));
             }
             Some(t_a.elapsed().as_secs_f64() * 1e3)
         }
