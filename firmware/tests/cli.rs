@@ -286,23 +286,33 @@ fn count_policy_keeps_and_counts_bad_packets() {
     assert!(missing_count * 2 < missing_verify);
 }
 
-#[test]
-fn replay_with_odometry_follows_the_true_pose() {
-    let dir = tmp("odom-ds");
+/// A dataset's replay recordings (no Method A/B files, no pictures) under a fresh `name`.
+fn recordings(name: &str, scenarios: usize, frames: usize, seed: u64) -> PathBuf {
+    let dir = tmp(name);
     let _ = std::fs::remove_dir_all(&dir);
     let cfg = sim::dataset::DatasetConfig {
-        scenarios: 2,
-        frames: 40,
-        seed: 5,
+        scenarios,
+        frames,
+        seed,
         method_b: false,
         method_a: false,
         pictures: 0,
         ..sim::dataset::DatasetConfig::default()
     };
     sim::dataset::generate(&cfg, &dir, |_| {}).unwrap();
-    // Scenario 1 drives a waypoint tour.
-    let rec = dir.join("recordings/s0001");
-    let out = tmp("odom.jsonl");
+    dir
+}
+
+fn json_lines(path: &Path) -> Vec<Value> {
+    std::fs::read_to_string(path)
+        .unwrap()
+        .lines()
+        .map(|l| serde_json::from_str(l).unwrap())
+        .collect()
+}
+
+/// `umbra replay` of recording `rec` with its odometry into `out`: (output lines, truth lines).
+fn replay_recording(rec: &Path, out: &Path) -> (Vec<Value>, Vec<Value>) {
     let o = umbra(&[
         "replay",
         rec.join("capture.bin").to_str().unwrap(),
@@ -313,16 +323,15 @@ fn replay_with_odometry_follows_the_true_pose() {
         "--quiet",
     ]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    let frames: Vec<Value> = std::fs::read_to_string(&out)
-        .unwrap()
-        .lines()
-        .map(|l| serde_json::from_str(l).unwrap())
-        .collect();
-    let truth: Vec<Value> = std::fs::read_to_string(rec.join("truth.jsonl"))
-        .unwrap()
-        .lines()
-        .map(|l| serde_json::from_str(l).unwrap())
-        .collect();
+    (json_lines(out), json_lines(&rec.join("truth.jsonl")))
+}
+
+#[test]
+fn replay_with_odometry_follows_the_true_pose() {
+    let dir = recordings("odom-ds", 2, 40, 5);
+    // Scenario 1 drives a waypoint tour.
+    let rec = dir.join("recordings/s0001");
+    let (frames, truth) = replay_recording(&rec, &tmp("odom.jsonl"));
     assert_eq!(frames.len(), truth.len());
     let f = |v: &Value| v.as_f64().unwrap();
     let last = frames.last().unwrap();
@@ -331,11 +340,7 @@ fn replay_with_odometry_follows_the_true_pose() {
     // An independent integration of the same samples (Burger constants, plain arithmetic),
     // to each frame's time (interpolated between samples): the runtime must agree with it to the
     // millimetre.
-    let odom: Vec<Value> = std::fs::read_to_string(rec.join("odom.jsonl"))
-        .unwrap()
-        .lines()
-        .map(|l| serde_json::from_str(l).unwrap())
-        .collect();
+    let odom = json_lines(&rec.join("odom.jsonl"));
     let m_per_tick = 2.0 * std::f64::consts::PI * 0.033 / 4096.0;
     let (mut x, mut y, mut th) = (0.0f64, 0.0f64, 0.0f64);
     let mut prev: Option<(i64, i64)> = None;
@@ -478,42 +483,13 @@ fn calibrate_compass_writes_the_config_that_run_uses() {
 fn replay_of_a_simulated_recording_finds_its_true_objects() {
     // Method A end to end: capture + odometry through `umbra replay`, objects scored against
     // the recording's truth (same class within 0.3 m, `interfaces.md` §3).
-    let dir = tmp("method-a-ds");
-    let _ = std::fs::remove_dir_all(&dir);
-    let cfg = sim::dataset::DatasetConfig {
-        scenarios: 4,
-        frames: 60,
-        seed: 11,
-        method_b: false,
-        method_a: false,
-        pictures: 0,
-        ..sim::dataset::DatasetConfig::default()
-    };
-    sim::dataset::generate(&cfg, &dir, |_| {}).unwrap();
+    let dir = recordings("method-a-ds", 4, 60, 11);
     let (mut reported, mut right, mut with_walls, mut frames_seen) = (0, 0, 0, 0);
     for s in 0..4 {
-        let rec = dir.join(format!("recordings/s{s:04}"));
-        let out = tmp(&format!("method-a-{s}.jsonl"));
-        let o = umbra(&[
-            "replay",
-            rec.join("capture.bin").to_str().unwrap(),
-            "--odom",
-            rec.join("odom.jsonl").to_str().unwrap(),
-            "--jsonl",
-            out.to_str().unwrap(),
-            "--quiet",
-        ]);
-        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-        let frames: Vec<Value> = std::fs::read_to_string(&out)
-            .unwrap()
-            .lines()
-            .map(|l| serde_json::from_str(l).unwrap())
-            .collect();
-        let truth: Vec<Value> = std::fs::read_to_string(rec.join("truth.jsonl"))
-            .unwrap()
-            .lines()
-            .map(|l| serde_json::from_str(l).unwrap())
-            .collect();
+        let (frames, truth) = replay_recording(
+            &dir.join(format!("recordings/s{s:04}")),
+            &tmp(&format!("method-a-{s}.jsonl")),
+        );
         let f = |v: &Value| v.as_f64().unwrap();
         for (frame, t) in frames.iter().zip(&truth).skip(30) {
             frames_seen += 1;

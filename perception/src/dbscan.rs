@@ -266,8 +266,8 @@ impl Dbscan {
             return;
         }
 
-        // Grid: cells of eps_min, grown until the bounds fit.
-        // Cells of ε_min / √2: any two points in one cell are within ε_min of each other.
+        // Grid: cells of ε_min / √2 (any two points in one cell are within ε_min of each
+        // other), grown until the bounds fit.
         let mut cell = eps_min * core::f32::consts::FRAC_1_SQRT_2;
         let dims = |cell: f32| {
             (

@@ -44,6 +44,17 @@ pub trait Classifier {
     fn classify(&self, features: &[f32; N_FEATURES]) -> (Option<ObjectClass>, f32);
 }
 
+/// The classifier that recognises nothing: every candidate stays unclassified (for collecting
+/// training data, where the labels come from elsewhere).
+#[derive(Debug, Clone, Copy, Default)]
+pub struct Unclassified;
+
+impl Classifier for Unclassified {
+    fn classify(&self, _: &[f32; N_FEATURES]) -> (Option<ObjectClass>, f32) {
+        (None, 0.0)
+    }
+}
+
 /// A merged group of fragments before classification.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct Candidate {
@@ -158,8 +169,8 @@ impl MethodA {
         self.dbscan.run(self.cloud.iter(), &cfg.dbscan);
         self.stats.dbscan = self.dbscan.stats();
 
-        for (k, c) in self.dbscan.clusters().iter().enumerate() {
-            let pts = &self.dbscan.points()[c.range()];
+        for k in 0..self.dbscan.clusters().len() {
+            let pts = self.dbscan.cluster_points(k);
             let pb = shape::principal_box(&[pts]);
             if walls::is_wall(&pb, &cfg.walls) {
                 self.stats.wall_clusters += 1;
@@ -190,15 +201,21 @@ impl MethodA {
         for g in 0..n_groups {
             let mut parts: [&[Point2]; MAX_CLUSTERS] = [&[]; MAX_CLUSTERS];
             let mut np = 0;
-            for (f, &gi) in self.frags.iter().zip(self.group.iter()) {
+            let mut last = 0;
+            for (i, (f, &gi)) in self.frags.iter().zip(self.group.iter()).enumerate() {
                 if gi as usize == g {
-                    parts[np] =
-                        &self.dbscan.points()[self.dbscan.clusters()[f.cluster as usize].range()];
+                    parts[np] = self.dbscan.cluster_points(f.cluster as usize);
                     np += 1;
+                    last = i;
                 }
             }
             let parts = &parts[..np];
-            let bbox = shape::min_area_box(parts);
+            // A lone fragment's box was computed for the merge already.
+            let bbox = if np == 1 {
+                self.frags[last].bbox
+            } else {
+                shape::min_area_box(parts)
+            };
             let angle = match cfg.frame {
                 FeatureFrame::Object => bbox.angle,
                 FeatureFrame::Axis => 0.0,
@@ -245,9 +262,7 @@ impl MethodA {
             .iter()
             .zip(self.group.iter())
             .filter(move |(_, g)| **g as usize == i)
-            .flat_map(move |(f, _)| {
-                self.dbscan.points()[self.dbscan.clusters()[f.cluster as usize].range()].iter()
-            })
+            .flat_map(move |(f, _)| self.dbscan.cluster_points(f.cluster as usize).iter())
     }
 
     /// Wall segments of the last run.

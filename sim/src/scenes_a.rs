@@ -251,14 +251,7 @@ pub fn run_scene(
 #[cfg(test)]
 mod test {
     use super::*;
-    use perception::features::N_FEATURES;
-
-    struct Nobody;
-    impl Classifier for Nobody {
-        fn classify(&self, _: &[f32; N_FEATURES]) -> (Option<ObjectClass>, f32) {
-            (None, 0.0)
-        }
-    }
+    use perception::method_a::Unclassified;
 
     #[test]
     fn scenes_find_walls_and_label_furniture() {
@@ -271,17 +264,28 @@ mod test {
         let mut furniture = 0;
         let mut views = 0;
         for i in [0, 2] {
-            run_scene(i, &cfg, &MethodAConfig::default(), &mut m, &Nobody, |v| {
-                views += 1;
-                assert!(!v.method.segments().is_empty());
-                for k in 0..v.method.candidates().len() {
-                    let l =
-                        label_points(v.world, &v.map_to_world, v.method.candidate_points(k), 0.1);
-                    if matches!(l, TruthLabel::Object(..)) {
-                        furniture += 1;
+            run_scene(
+                i,
+                &cfg,
+                &MethodAConfig::default(),
+                &mut m,
+                &Unclassified,
+                |v| {
+                    views += 1;
+                    assert!(!v.method.segments().is_empty());
+                    for k in 0..v.method.candidates().len() {
+                        let l = label_points(
+                            v.world,
+                            &v.map_to_world,
+                            v.method.candidate_points(k),
+                            0.1,
+                        );
+                        if matches!(l, TruthLabel::Object(..)) {
+                            furniture += 1;
+                        }
                     }
-                }
-            });
+                },
+            );
         }
         assert_eq!(views, 2);
         assert!(furniture >= 2, "{furniture}");

@@ -20,9 +20,8 @@ use clap::{Parser, Subcommand, ValueEnum};
 use firmware::eval_a::{self, Score, csv_header, rows_of};
 use indicatif::{ProgressBar, ProgressStyle};
 use models::train::{TrainConfig, emit_rust, read_csv, train};
-use perception::class::ObjectClass;
-use perception::features::{FeatureFrame, N_FEATURES};
-use perception::method_a::{Classifier, MethodA, MethodAConfig};
+use perception::features::FeatureFrame;
+use perception::method_a::{MethodA, MethodAConfig, Unclassified};
 use sim::scenes_a::{PoseSource, SceneConfig, run_scene};
 
 #[derive(Parser)]
@@ -109,10 +108,11 @@ fn bar(n: usize, what: &str) -> ProgressBar {
     b
 }
 
-struct Nobody;
-impl Classifier for Nobody {
-    fn classify(&self, _: &[f32; N_FEATURES]) -> (Option<ObjectClass>, f32) {
-        (None, 0.0)
+fn feature_frame(object: bool) -> FeatureFrame {
+    if object {
+        FeatureFrame::Object
+    } else {
+        FeatureFrame::Axis
     }
 }
 
@@ -147,7 +147,7 @@ fn run(cli: Cli) -> Result<(), String> {
                     &cfg,
                     &MethodAConfig::default(),
                     &mut method,
-                    &Nobody,
+                    &Unclassified,
                     |v| {
                         for r in rows_of(v) {
                             *counts.entry(r.truth).or_insert(0usize) += 1;
@@ -209,11 +209,7 @@ fn run(cli: Cli) -> Result<(), String> {
             let cfg = scene_cfg(seed, pose);
             let forest = models::forest::forest();
             let acfg = MethodAConfig {
-                frame: if forest.object_frame {
-                    FeatureFrame::Object
-                } else {
-                    FeatureFrame::Axis
-                },
+                frame: feature_frame(forest.object_frame),
                 ..MethodAConfig::default()
             };
             let go = |acfg: &MethodAConfig, c: &dyn Fn(&MethodAConfig, &ProgressBar) -> Score| {
@@ -253,11 +249,7 @@ fn run(cli: Cli) -> Result<(), String> {
                     )
                     .leak();
                     let a = MethodAConfig {
-                        frame: if object {
-                            FeatureFrame::Object
-                        } else {
-                            FeatureFrame::Axis
-                        },
+                        frame: feature_frame(object),
                         ..MethodAConfig::default()
                     };
                     let s = eval(&a, &f);
