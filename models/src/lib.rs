@@ -7,8 +7,7 @@
 //! | [`forest`]        | the Method A classifier at run time over `const` tables (`no_std`) |
 //! | [`forest_tables`] | the trained forest, generated from `models/data/forest-train.csv` |
 //! | `train`           | the forest trainer and table emitter (`std` feature, host only) |
-//!
-//! The Method B YOLOv8n runner (tract) arrives with its issue.
+//! | `yolo`            | the Method B YOLOv8n runner over tract (`yolo` feature, host and Pi) |
 #![cfg_attr(not(any(test, feature = "std")), no_std)]
 #![deny(unsafe_code, missing_docs)]
 
@@ -19,6 +18,8 @@ pub mod forest;
 pub mod forest_tables;
 #[cfg(feature = "std")]
 pub mod train;
+#[cfg(feature = "yolo")]
+pub mod yolo;
 
 /// Class order of the model outputs (the index of a class score is its position here).
 pub const CLASSES: [ObjectClass; 4] = ObjectClass::ALL;

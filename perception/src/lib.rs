@@ -18,8 +18,9 @@
 //! | [`merge`]      | fragments (legs, pieces) merged into objects, with guards |
 //! | [`features`]   | the 9-D feature vector, in the object's frame or the map's |
 //! | [`method_a`]   | the geometric pipeline end to end, classifier as a parameter |
+//! | [`yolo`]       | Method B's output: YOLOv8 decode, suppression, map-frame centres |
 //!
-//! YOLO decoding arrives with its issue; each capacity is a named constant listed in
+//! Each capacity is a named constant listed in
 //! `memory-budget.md`.
 #![cfg_attr(not(any(test, feature = "std")), no_std)]
 #![deny(unsafe_code, missing_docs)]
@@ -36,3 +37,4 @@ pub mod pose;
 pub mod raster;
 pub mod shape;
 pub mod walls;
+pub mod yolo;

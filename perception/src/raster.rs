@@ -99,8 +99,34 @@ pub fn row_for_range(range_m: f32, cfg: &RasterConfig) -> Option<usize> {
     })
 }
 
-/// Writes the raster of three revolutions, `scans[0]` the newest, into `out` (HWC, cleared
-/// first).
+/// Checks the settings and calls `draw(row, column, channel)` for every pixel the three
+/// revolutions set, `scans[0]` the newest (channel 0). The one definition of the encoding:
+/// [`encode_hwc`] (PNG layout, the dataset) and [`encode_chw_f32`] (the model's input tensor,
+/// the runtime) are both this walk.
+pub fn for_each_hit<S: ScanBins + ?Sized>(
+    scans: [&S; RASTER_C],
+    cfg: &RasterConfig,
+    mut draw: impl FnMut(usize, usize, usize),
+) -> Result<(), RasterError> {
+    if !(cfg.max_range_m.is_finite() && cfg.max_range_m > 0.0) {
+        return Err(RasterError::BadMaxRange);
+    }
+    for (c, scan) in scans.iter().enumerate() {
+        for d in 0..SCAN_COLUMNS {
+            let (r, valid) = scan.bin(d);
+            if !valid {
+                continue;
+            }
+            if let Some(row) = row_for_range(r, cfg) {
+                draw(row, d, c);
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Writes the raster of three revolutions, `scans[0]` the newest, into `out` (HWC `u8`, the
+/// layout of an RGB PNG; cleared first).
 pub fn encode_hwc<S: ScanBins + ?Sized>(
     out: &mut [u8],
     scans: [&S; RASTER_C],
@@ -109,22 +135,28 @@ pub fn encode_hwc<S: ScanBins + ?Sized>(
     if out.len() != RASTER_LEN {
         return Err(RasterError::BadBufferLength);
     }
-    if !(cfg.max_range_m.is_finite() && cfg.max_range_m > 0.0) {
-        return Err(RasterError::BadMaxRange);
-    }
     out.fill(0);
-    for (c, scan) in scans.iter().enumerate() {
-        for d in 0..SCAN_COLUMNS {
-            let (r, valid) = scan.bin(d);
-            if !valid {
-                continue;
-            }
-            if let Some(row) = row_for_range(r, cfg) {
-                out[(row * RASTER_W + d) * RASTER_C + c] = HIT;
-            }
-        }
+    for_each_hit(scans, cfg, |row, col, c| {
+        out[(row * RASTER_W + col) * RASTER_C + c] = HIT;
+    })
+}
+
+/// Writes the same raster as the model's input tensor: `1 × 3 × 64 × 384` `f32`, planar (CHW),
+/// a drawn pixel 1.0 (= 255 / 255, Ultralytics' input scaling), everything else 0.0; channel 0
+/// is the newest revolution, as in the PNG Ultralytics trained on (it reads BGR and flips to
+/// RGB). Cleared first; meant to be called on the tensor's own buffer, so no copy follows.
+pub fn encode_chw_f32<S: ScanBins + ?Sized>(
+    out: &mut [f32],
+    scans: [&S; RASTER_C],
+    cfg: &RasterConfig,
+) -> Result<(), RasterError> {
+    if out.len() != RASTER_LEN {
+        return Err(RasterError::BadBufferLength);
     }
-    Ok(())
+    out.fill(0.0);
+    for_each_hit(scans, cfg, |row, col, c| {
+        out[(c * RASTER_H + row) * RASTER_W + col] = 1.0;
+    })
 }
 
 #[cfg(test)]
@@ -194,6 +226,27 @@ mod test {
     }
 
     const GOLDEN_HASH: u64 = 0x402e_a469_ee3b_c5f1;
+
+    /// The tensor layout is the PNG layout transposed, 255 → 1.0.
+    #[test]
+    fn tensor_is_the_png_transposed() {
+        let newest = scan(&[(0, 1.0), (90, 2.0), (359, 4.2)]);
+        let prev = scan(&[(0, 1.0), (180, 0.5)]);
+        let oldest = scan(&[(45, 3.0), (100, -1.0)]);
+        let cfg = RasterConfig::default();
+        let mut hwc = [0u8; RASTER_LEN];
+        encode_hwc(&mut hwc, [&newest, &prev, &oldest], &cfg).unwrap();
+        let mut chw = std::vec![0.5f32; RASTER_LEN];
+        encode_chw_f32(&mut chw, [&newest, &prev, &oldest], &cfg).unwrap();
+        for y in 0..RASTER_H {
+            for x in 0..RASTER_W {
+                for c in 0..RASTER_C {
+                    let v = hwc[(y * RASTER_W + x) * RASTER_C + c];
+                    assert_eq!(chw[(c * RASTER_H + y) * RASTER_W + x], f32::from(v) / 255.0);
+                }
+            }
+        }
+    }
 
     #[test]
     fn errors() {

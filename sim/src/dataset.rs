@@ -380,9 +380,15 @@ pub fn generate(
         0.0
     };
     if cfg.method_b {
+        // Ultralytics resolves a relative `path` against its working directory, not the
+        // yaml's folder: write the folder's absolute path.
+        let root = fs::canonicalize(out).map_err(|e| io_err(out, e))?;
         let yaml = format!(
-            "# umbra simulator dataset, seed {}, {} scenarios × {} frames; splits by scenario\npath: .\ntrain: images/train\nval: images/val\ntest: images/test\nnames:\n  0: chair\n  1: box\n  2: desk\n  3: door_frame\n",
-            cfg.seed, cfg.scenarios, cfg.frames
+            "# umbra simulator dataset, seed {}, {} scenarios × {} frames; splits by scenario\npath: {}\ntrain: images/train\nval: images/val\ntest: images/test\nnames:\n  0: chair\n  1: box\n  2: desk\n  3: door_frame\n",
+            cfg.seed,
+            cfg.scenarios,
+            cfg.frames,
+            root.display()
         );
         let p = out.join("data.yaml");
         fs::write(&p, yaml).map_err(|e| io_err(&p, e))?;

@@ -1,0 +1,76 @@
+"""Export a trained checkpoint to the ONNX files the runtime loads.
+
+    python training/export.py --weights runs/NAME/weights/best.pt --out models/yolo \
+        [--calib DATASET/images/train --calib-images 256]
+
+Writes `umbra-yolov8n.onnx` (fp32, opset 17, simplified, static 1x3x64x384 -> 1x8x504) and,
+with `--calib`, `umbra-yolov8n-int8.onnx`: static int8, QOperator form, convolutions only
+(`QLinearConv`, per-tensor): the form tract executes in integer. QDQ is run in float by tract
+(slower than fp32), QOperator on all ops needs `QLinearSigmoid`, which tract rejects, and the
+head's final Concat must stay float (pixels and [0, 1] scores cannot share one scale).
+Calibration images are the first N of the folder in name order (deterministic).
+"""
+
+import argparse
+import shutil
+from pathlib import Path
+
+import numpy as np
+
+import offline  # noqa: F401
+from ultralytics import YOLO
+
+
+def png_tensor(path: Path) -> np.ndarray:
+    """A dataset PNG as the runtime's input tensor (1x3x64x384 float, channel 0 = red = newest)."""
+    import cv2
+
+    bgr = cv2.imread(str(path), cv2.IMREAD_COLOR)
+    rgb = bgr[:, :, ::-1]
+    return np.ascontiguousarray(rgb.transpose(2, 0, 1)[None].astype(np.float32) / 255.0)
+
+
+def quantise(fp32: Path, out: Path, calib: Path, n: int) -> None:
+    from onnxruntime.quantization import (CalibrationDataReader, QuantFormat, QuantType,
+                                          quantize_static)
+
+    files = sorted(calib.glob("*.png"))[:n]
+
+    class Reader(CalibrationDataReader):
+        def __init__(self):
+            self.it = iter(files)
+
+        def get_next(self):
+            f = next(self.it, None)
+            return None if f is None else {"images": png_tensor(f)}
+
+    quantize_static(
+        str(fp32), str(out), Reader(), quant_format=QuantFormat.QOperator,
+        op_types_to_quantize=["Conv"], per_channel=False, activation_type=QuantType.QUInt8,
+        weight_type=QuantType.QInt8,
+    )
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--weights", required=True)
+    ap.add_argument("--out", default="models/yolo")
+    ap.add_argument("--calib", help="folder of PNGs for int8 calibration")
+    ap.add_argument("--calib-images", type=int, default=256)
+    a = ap.parse_args()
+    out = Path(a.out)
+    out.mkdir(parents=True, exist_ok=True)
+    model = YOLO(a.weights)
+    f = model.export(format="onnx", imgsz=(64, 384), opset=17, simplify=True, dynamic=False,
+                     batch=1, device="cpu")
+    fp32 = out / "umbra-yolov8n.onnx"
+    shutil.copy(f, fp32)
+    print(f"wrote {fp32}")
+    if a.calib:
+        q = out / "umbra-yolov8n-int8.onnx"
+        quantise(fp32, q, Path(a.calib), a.calib_images)
+        print(f"wrote {q}")
+
+
+if __name__ == "__main__":
+    main()
