@@ -15,6 +15,7 @@ import time
 from pathlib import Path
 
 import offline  # noqa: F401  (must come before ultralytics)
+from exact import ExactTrainer
 from ultralytics import YOLO
 
 HERE = Path(__file__).resolve().parent
@@ -42,14 +43,14 @@ def main() -> None:
     last = HERE / "runs" / a.name / "weights" / "last.pt"
     if a.resume:
         model = YOLO(str(last))
-        model.train(resume=True)
+        model.train(resume=True, trainer=ExactTrainer)
     else:
         model = YOLO(str(HERE / "yolov8n-umbra.yaml"))
         model.train(
             data=str(Path(a.data).resolve()), imgsz=384, rect=True, epochs=a.epochs,
             batch=a.batch, workers=a.workers, device=a.device, seed=a.seed, deterministic=True,
             pretrained=False, amp=a.device != "cpu", plots=False, project=str(HERE / "runs"),
-            name=a.name, exist_ok=True, val=True, **OFF,
+            name=a.name, exist_ok=True, val=True, trainer=ExactTrainer, **OFF,
         )
     print(f"trained in {time.time() - t0:.0f} s: {HERE / 'runs' / a.name / 'weights'}")
 

@@ -43,6 +43,15 @@
 //! door_min_gap_m = 0.9
 //! door_max_gap_m = 1.4
 //! lidar_mount_x_m = -0.032     # LiDAR position on the robot (Burger)
+//!
+//! [method_b]                   # the learned pipeline (docs/method-b.md)
+//! enabled = true
+//! model = "/opt/umbra/other.onnx"  # absent: the compiled-in model (`--model` overrides)
+//! conf = 0.25                  # class score a detection needs
+//! iou = 0.7                    # suppression overlap
+//! agnostic_nms = true          # one report per object whatever the classes
+//! max_range_m = 4.0            # range of the raster's last row: must match the training data
+//! threads = 1                  # tract worker threads
 //! ```
 
 use std::fmt;
@@ -239,6 +248,41 @@ impl Default for MethodASettings {
     }
 }
 
+/// `[method_b]`: the learned pipeline's settings.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct MethodBSettings {
+    /// Run Method B at all.
+    pub enabled: bool,
+    /// An ONNX file instead of the compiled-in model.
+    pub model: Option<PathBuf>,
+    /// Score threshold.
+    pub conf: f32,
+    /// Suppression IoU.
+    pub iou: f32,
+    /// Class-agnostic suppression.
+    pub agnostic_nms: bool,
+    /// Range of the raster's last row, m.
+    pub max_range_m: f32,
+    /// tract worker threads.
+    pub threads: usize,
+}
+
+impl Default for MethodBSettings {
+    fn default() -> Self {
+        let d = perception::yolo::DecodeConfig::RUNTIME;
+        MethodBSettings {
+            enabled: true,
+            model: None,
+            conf: d.conf,
+            iou: d.iou,
+            agnostic_nms: d.agnostic,
+            max_range_m: perception::raster::RasterConfig::default().max_range_m,
+            threads: 1,
+        }
+    }
+}
+
 /// The whole configuration.
 #[derive(Debug, Clone, PartialEq, Deserialize, Default)]
 #[serde(default, deny_unknown_fields)]
@@ -255,6 +299,8 @@ pub struct Config {
     pub compass: CompassSettings,
     /// Method A.
     pub method_a: MethodASettings,
+    /// Method B.
+    pub method_b: MethodBSettings,
 }
 
 /// A configuration error, naming the file and field.
@@ -343,6 +389,23 @@ impl Config {
                 a.min_cluster_points
             ));
         }
+        let b = &self.method_b;
+        let within_b = |name: &str, v: f32, lo: f32, hi: f32| {
+            if v.is_finite() && (lo..=hi).contains(&v) {
+                Ok(())
+            } else {
+                Err(format!("method_b.{name} = {v}: must be within [{lo}, {hi}]"))
+            }
+        };
+        within_b("conf", b.conf, 0.0, 1.0)?;
+        within_b("iou", b.iou, 0.0, 1.0)?;
+        within_b("max_range_m", b.max_range_m, 0.5, 65.0)?;
+        if !(1..=64).contains(&b.threads) {
+            return Err(format!(
+                "method_b.threads = {}: must be within 1..=64",
+                b.threads
+            ));
+        }
         let d = self.runtime.deadline_ms;
         if !(d.is_finite() && d > 0.0 && d <= 10_000.0) {
             return Err(format!(
@@ -373,6 +436,24 @@ impl Config {
             f.set_field_reference(r[0], r[1]);
         }
         f
+    }
+
+    /// Method B's decoding settings.
+    pub fn method_b_decode(&self) -> perception::yolo::DecodeConfig {
+        let b = &self.method_b;
+        perception::yolo::DecodeConfig {
+            conf: b.conf,
+            iou: b.iou,
+            agnostic: b.agnostic_nms,
+            ..perception::yolo::DecodeConfig::RUNTIME
+        }
+    }
+
+    /// Method B's raster settings.
+    pub fn method_b_raster(&self) -> perception::raster::RasterConfig {
+        perception::raster::RasterConfig {
+            max_range_m: self.method_b.max_range_m,
+        }
     }
 
     /// The Method A pipeline settings (its range window is the LiDAR's).
@@ -457,6 +538,10 @@ mod test {
                 .unwrap_err()
                 .contains("method_a.door_max_gap_m")
         );
+        let bad: Config = toml::from_str("[method_b]\nconf = 1.5\n").unwrap();
+        assert!(bad.validate().unwrap_err().contains("method_b.conf"));
+        let bad: Config = toml::from_str("[method_b]\nthreads = 0\n").unwrap();
+        assert!(bad.validate().unwrap_err().contains("method_b.threads"));
         let bad: Config = toml::from_str("[method_a]\neps_min_m = nan\n").unwrap();
         assert!(bad.validate().unwrap_err().contains("method_a.eps_min_m"));
         let bad: Config = toml::from_str("[runtime]\ndeadline_ms = -1.0\n").unwrap();

@@ -12,6 +12,7 @@
 //! | [`odom`]     | odometry/compass input (`--odom` JSON Lines, the simulated robot) → pose |
 //! | [`output`]   | the JSON output line (§3) and per-revolution statistics     |
 //! | [`eval_a`]   | Method A scored against the simulator's truth; forest training rows |
+//! | [`eval_b`]     | Method B scored on a dataset split: P, R, mAP50, mAP50-95 as Ultralytics does |
 //! | [`confusion_png`] | the evaluation's confusion matrix as a PNG              |
 #![deny(unsafe_code, missing_docs)]
 
@@ -20,6 +21,7 @@ pub mod cli;
 pub mod config;
 pub mod confusion_png;
 pub mod eval_a;
+pub mod eval_b;
 pub mod odom;
 pub mod output;
 pub mod runner;

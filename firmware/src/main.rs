@@ -13,7 +13,8 @@ use firmware::calibrate;
 use firmware::cli::{Cli, Command, Common, LidarModel, Speed};
 use firmware::config::Config;
 use firmware::odom::{OdomFile, PoseState};
-use firmware::runner::{self, PoseInput, RunOptions, SecondsClock, Summary};
+use firmware::runner::{self, MethodBSetup, PoseInput, RunOptions, SecondsClock, Summary};
+use models::yolo::{YoloModel, YoloOptions};
 use firmware::source::{LidarSource, Pacing};
 
 /// Exit status for bad arguments or configuration.
@@ -313,6 +314,7 @@ fn run_loop(
     if let Err(e) = ctrlc::set_handler(move || flag.store(true, Ordering::Relaxed)) {
         log::warn!("cannot install the Ctrl-C handler ({e}); Ctrl-C will stop without a summary");
     }
+    let method_b = load_method_b(cfg, common)?;
     let opts = RunOptions {
         frames: common.frames,
         seconds: common.seconds,
@@ -327,11 +329,38 @@ fn run_loop(
             .method_a
             .enabled
             .then(|| (cfg.method_a(), cfg.lidar_mount())),
+        method_b,
     };
     let summary = runner::run(source, cfg.lds01(), opts)
         .map_err(|e| (EXIT_FAULT, format!("cannot write output: {e}")))?;
     print_summary(&summary);
     Ok(())
+}
+
+/// Loads Method B's model (`--model`, else `[method_b] model`, else the compiled-in one); a
+/// bad file is a start-up error naming it (exit 2).
+fn load_method_b(cfg: &Config, common: &Common) -> Result<Option<MethodBSetup>, Failure> {
+    if !cfg.method_b.enabled {
+        if common.model.is_some() {
+            log::warn!("--model given but [method_b] enabled = false: Method B stays off");
+        }
+        return Ok(None);
+    }
+    let opts = YoloOptions {
+        threads: cfg.method_b.threads,
+    };
+    let model = match common.model.as_ref().or(cfg.method_b.model.as_ref()) {
+        Some(path) => YoloModel::load(path, opts),
+        None => YoloModel::builtin(opts),
+    }
+    .map_err(|e| (EXIT_USAGE, e.to_string()))?;
+    log::info!("Method B: {}", model.name());
+    Ok(Some(MethodBSetup {
+        model,
+        raster: cfg.method_b_raster(),
+        decode: cfg.method_b_decode(),
+        mount: cfg.lidar_mount(),
+    }))
 }
 
 fn print_summary(s: &Summary) {

@@ -32,6 +32,9 @@ pub struct ObjectOut {
     pub score: f64,
     /// `A`, `B` or `AB`.
     pub source: &'static str,
+    /// Method B's box `[cx, cy, w, h]` in pixels of the 384 × 64 input (B and AB only).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub bbox: Option<[f64; 4]>,
 }
 
 /// A wall segment.
@@ -70,6 +73,10 @@ pub struct TimingOut {
     /// Method A, cloud update to labelled objects (absent when Method A is off).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub method_a: Option<f64>,
+    /// Method B, raster to decoded boxes (absent when off and for the first two
+    /// revolutions, before the raster has its three).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub method_b: Option<f64>,
     /// Whole frame.
     pub total: f64,
 }
@@ -104,6 +111,8 @@ pub struct FaultsOut {
     pub lidar_link_reopened: u64,
     /// Compass reads that failed (bus error, timeout).
     pub compass_errors: u64,
+    /// Method B frames that failed (raster, inference or decoding error): no B objects.
+    pub method_b_errors: u64,
 }
 
 impl FaultsOut {
@@ -123,6 +132,7 @@ impl FaultsOut {
             lidar_link_lost: link.0,
             lidar_link_reopened: link.1,
             compass_errors: 0,
+            method_b_errors: 0,
         }
     }
 }
@@ -210,6 +220,7 @@ mod test {
                 ingest: 0.1,
                 pose: 0.0,
                 method_a: None,
+                method_b: None,
                 total: 0.2,
             },
             deadline_ms: 250.0,

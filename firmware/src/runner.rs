@@ -1,11 +1,15 @@
-//! The frame loop as it stands: ingest → pose → Method A → output. One frame per LiDAR
-//! revolution.
+//! The frame loop as it stands: ingest → pose → Method A → Method B → output. One frame per
+//! LiDAR revolution.
 //!
 //! `timing_ms.ingest` is the time spent decoding the frame's bytes (not waiting for them).
 //! Bytes are read into one fixed buffer ([`READ_CHUNK`] bytes), fed to the LDS-01 stream,
 //! and each finished revolution becomes a frame: a statistics line, a JSON line, or both.
 //! The pose is taken at the revolution's first ray (the output line's pose) and at its last,
-//! so Method A de-skews the scan. Method B joins as its issue lands.
+//! so Method A de-skews the scan. Method B keeps the last three revolutions' bins and the
+//! pose at the middle of each: its raster is the three, its boxes are placed from the middle
+//! revolution's pose (the pose the training labels used). A B detection within
+//! [`AGREE_M`] of an A object of the same class makes that object `AB`; the others are
+//! reported as `B`.
 
 use std::io::Write;
 use std::sync::Arc;
@@ -18,6 +22,10 @@ use drivers::lds01::{Lds01Config, Lds01Faults, Lds01Stream};
 use perception::cloud::Scan;
 use perception::geometry::{Point2, Pose2};
 use perception::method_a::{MethodA, MethodAConfig};
+use perception::raster::{RasterConfig, SCAN_COLUMNS, encode_chw_f32};
+use perception::yolo::{ANCHORS, DecodeConfig, DecodeScratch, Detection, MAX_DETECTIONS, decode};
+
+use models::yolo::YoloModel;
 
 use drivers::opencr::OpencrReader;
 
@@ -62,19 +70,49 @@ pub struct RunOptions {
     pub pose: Option<PoseInput>,
     /// Method A settings and the LiDAR's pose on the robot; `None`: Method A off.
     pub method_a: Option<(MethodAConfig, Pose2)>,
+    /// Method B's model and settings; `None`: Method B off.
+    pub method_b: Option<MethodBSetup>,
 }
+
+/// Method B at run time: the loaded model and how to read its boxes.
+pub struct MethodBSetup {
+    /// The network, loaded and optimised at start-up.
+    pub model: YoloModel,
+    /// Raster settings (must match the training data's).
+    pub raster: RasterConfig,
+    /// Thresholds and suppression.
+    pub decode: DecodeConfig,
+    /// The LiDAR's pose on the robot.
+    pub mount: Pose2,
+}
+
+/// Revolutions Method B's raster is made of.
+pub const METHOD_B_HISTORY: usize = perception::raster::RASTER_C;
+
+/// A Method B box this close (m) to a Method A object of the same class is the same object.
+pub const AGREE_M: f32 = 0.3;
 
 /// What the loop keeps between frames, allocated once at start-up.
 struct FrameState {
     method_a: Box<MethodA>,
     ranges: [f32; drivers::lds01::READINGS_PER_REV],
+    /// The last three revolutions' ranges by bin (0 = not drawn), slot `n % 3` for the n-th.
+    history: [[f32; SCAN_COLUMNS]; METHOD_B_HISTORY],
+    /// The robot's map pose at the middle of each of those revolutions.
+    history_pose: [Pose2; METHOD_B_HISTORY],
+    /// Revolutions put into the history.
+    revolutions: u64,
+    detections: heapless::Vec<Detection, MAX_DETECTIONS>,
+    decode_scratch: Box<DecodeScratch>,
+    method_b_errors: u64,
     objects: Vec<ObjectOut>,
     walls: Vec<WallOut>,
     doors: Vec<DoorOut>,
 }
 
 /// Output capacity reserved at start-up (so that the loop does not allocate).
-const OUT_CAPACITY: usize = perception::method_a::MAX_CANDIDATES + perception::doors::MAX_DOORS;
+const OUT_CAPACITY: usize =
+    perception::method_a::MAX_CANDIDATES + perception::doors::MAX_DOORS + MAX_DETECTIONS;
 
 /// Samples queued from a live source before the frame they belong to, at most (20 Hz encoders
 /// over 2 s; older ones are fed at once rather than dropped).
@@ -199,6 +237,12 @@ pub fn run(
     let mut state = FrameState {
         method_a: Box::new(MethodA::new()),
         ranges: [0.0; drivers::lds01::READINGS_PER_REV],
+        history: [[0.0; SCAN_COLUMNS]; METHOD_B_HISTORY],
+        history_pose: [Pose2::IDENTITY; METHOD_B_HISTORY],
+        revolutions: 0,
+        detections: heapless::Vec::new(),
+        decode_scratch: Box::new(DecodeScratch::new()),
+        method_b_errors: 0,
         objects: Vec::with_capacity(OUT_CAPACITY),
         walls: Vec::with_capacity(perception::walls::MAX_SEGMENTS),
         doors: Vec::with_capacity(perception::doors::MAX_DOORS),
@@ -319,7 +363,79 @@ fn object_a(
         y: f64::from(centre.y),
         score: f64::from(score),
         source: "A",
+        bbox: None,
     }
+}
+
+/// The pose halfway between two poses (heading along the shorter way round).
+fn midway(a: &Pose2, b: &Pose2) -> Pose2 {
+    Pose2::new(
+        (a.x + b.x) / 2.0,
+        (a.y + b.y) / 2.0,
+        perception::geometry::wrap_angle(
+            a.theta + perception::geometry::wrap_angle(b.theta - a.theta) / 2.0,
+        ),
+    )
+}
+
+/// Runs Method B on the last three revolutions and adds its objects (or marks Method A's as
+/// agreed); `Err` carries the message of a failed frame.
+fn method_b_frame(b: &mut MethodBSetup, state: &mut FrameState) -> Result<(), String> {
+    let k = (state.revolutions - 1) as usize;
+    let (newest, prev, oldest) = (k % 3, (k + 2) % 3, (k + 1) % 3);
+    encode_chw_f32(
+        b.model.input_mut(),
+        [
+            &state.history[newest],
+            &state.history[prev],
+            &state.history[oldest],
+        ],
+        &b.raster,
+    )
+    .map_err(|e| e.to_string())?;
+    let (dets, scratch) = (&mut state.detections, &mut state.decode_scratch);
+    b.model
+        .run(|out| decode(out, ANCHORS, &b.decode, scratch, dets))
+        .map_err(|e| e.to_string())?
+        .map_err(|e| e.to_string())?;
+    let lidar = state.history_pose[prev].compose(&b.mount);
+    for d in state.detections.iter() {
+        let centre = d.centre(&lidar, &b.raster);
+        let bbox = Some([d.cx, d.cy, d.w, d.h].map(f64::from));
+        let class = d.class.as_str();
+        let agreed = state
+            .objects
+            .iter_mut()
+            .filter(|o| o.source == "A" && o.class == class)
+            .map(|o| {
+                let dist = ((o.x - f64::from(centre.x)).powi(2)
+                    + (o.y - f64::from(centre.y)).powi(2))
+                .sqrt();
+                (dist, o)
+            })
+            .filter(|(dist, _)| *dist <= f64::from(AGREE_M))
+            .min_by(|a, b| a.0.total_cmp(&b.0));
+        match agreed {
+            Some((_, o)) => {
+                o.source = "AB";
+                o.score = o.score.max(f64::from(d.score));
+                o.bbox = bbox;
+            }
+            None => {
+                let id = state.objects.len() as u32;
+                state.objects.push(ObjectOut {
+                    id,
+                    class,
+                    x: f64::from(centre.x),
+                    y: f64::from(centre.y),
+                    score: f64::from(d.score),
+                    source: "B",
+                    bbox,
+                });
+            }
+        }
+    }
+    Ok(())
 }
 
 /// Writes the stream's last finished revolution as one frame; returns `true` when the frame
@@ -376,11 +492,11 @@ fn emit_frame(
     state.objects.clear();
     state.walls.clear();
     state.doors.clear();
+    for (r, reading) in state.ranges.iter_mut().zip(rev.readings.iter()) {
+        *r = if reading.valid { reading.range_m } else { 0.0 };
+    }
     let method_a_ms = match opts.method_a.as_ref() {
         Some((cfg, mount)) => {
-            for (r, reading) in state.ranges.iter_mut().zip(rev.readings.iter()) {
-                *r = if reading.valid { reading.range_m } else { 0.0 };
-            }
             let m = &mut state.method_a;
             m.add_scan(
                 &Scan {
@@ -428,6 +544,23 @@ fn emit_frame(
         }
         None => None,
     };
+    let slot = (state.revolutions % 3) as usize;
+    state.history[slot].copy_from_slice(&state.ranges[..SCAN_COLUMNS]);
+    state.history_pose[slot] = midway(&pose, &end);
+    state.revolutions += 1;
+    let method_b_ms = match opts.method_b.as_mut() {
+        Some(b) if state.revolutions >= 3 => {
+            let t_b = Instant::now();
+            if let Err(e) = method_b_frame(b, state) {
+                if state.method_b_errors == 0 {
+                    log::warn!("Method B: {e}; frame goes on without it (counted)");
+                }
+                state.method_b_errors += 1;
+            }
+            Some(t_b.elapsed().as_secs_f64() * 1e3)
+        }
+        _ => None,
+    };
     let ingest_ms = ingest.as_secs_f64() * 1e3;
     let total_ms = ingest_ms + t_frame.elapsed().as_secs_f64() * 1e3;
     let missed = total_ms > opts.deadline_ms;
@@ -450,6 +583,7 @@ fn emit_frame(
                 ingest: ingest_ms,
                 pose: pose_ms,
                 method_a: method_a_ms,
+                method_b: method_b_ms,
                 total: total_ms,
             },
             deadline_ms: opts.deadline_ms,
@@ -460,6 +594,7 @@ fn emit_frame(
                 encoder_errors,
                 compass_rejected,
                 compass_errors,
+                method_b_errors: state.method_b_errors,
                 ..FaultsOut::new(
                     &stream.faults(),
                     summary.invalid_readings,

@@ -9,7 +9,7 @@ use drivers::dynamixel::{MAX_PACKET_LEN, StatusDecoder};
 use drivers::lds01::assembler::ASSEMBLER_REVOLUTIONS;
 use drivers::lds01::decoder::DECODER_BUFFER_LEN;
 use drivers::lds01::{Lds01Stream, READINGS_PER_REV, Reading, Revolution};
-use firmware::runner::READ_CHUNK;
+use firmware::runner::{METHOD_B_HISTORY, READ_CHUNK};
 use perception::cloud::{CLOUD_CAPACITY, GlobalCloud};
 use perception::dbscan::{Dbscan, GRID_CELLS, MAX_CLUSTERS};
 use perception::doors::{Door, MAX_DOORS};
@@ -97,6 +97,31 @@ fn buffers_in_code() -> Vec<(&'static str, usize, usize)> {
             "size_of::<perception::method_a::MethodA>()",
             1,
             size_of::<MethodA>(),
+        ),
+        (
+            "firmware::runner::METHOD_B_HISTORY",
+            METHOD_B_HISTORY,
+            size_of::<[f32; perception::raster::SCAN_COLUMNS]>(),
+        ),
+        (
+            "perception::raster::RASTER_LEN",
+            perception::raster::RASTER_LEN,
+            size_of::<f32>(),
+        ),
+        (
+            "perception::yolo::OUTPUT_LEN",
+            perception::yolo::OUTPUT_LEN,
+            size_of::<f32>(),
+        ),
+        (
+            "size_of::<perception::yolo::DecodeScratch>()",
+            1,
+            size_of::<perception::yolo::DecodeScratch>(),
+        ),
+        (
+            "perception::yolo::MAX_DETECTIONS",
+            perception::yolo::MAX_DETECTIONS,
+            size_of::<perception::yolo::Detection>(),
         ),
     ]
 }

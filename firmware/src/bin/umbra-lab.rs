@@ -10,6 +10,10 @@
 //!   `--compare-frames` training both frames from `--data` in memory and scoring each, and
 //!   `--merge-guards` scoring each merge guard alone.
 //!
+//! * `umbra-lab eval-b --data DATASET [--split test] [--model FILE] [--json OUT]` scores a
+//!   YOLO model (default: the compiled-in one) on a simulator dataset split with the Rust
+//!   evaluator (P, R, mAP50, mAP50-95 as Ultralytics computes them).
+//!
 //! Regenerating the committed forest is the two commands `forest-data` and `forest-train` with
 //! their defaults; both are deterministic.
 
@@ -95,6 +99,23 @@ enum Command {
         merge_guards: bool,
         #[arg(long, default_value = "models/data/forest-train.csv")]
         data: PathBuf,
+    },
+    /// Scores a YOLO model on a dataset split (Method B).
+    EvalB {
+        /// Dataset folder written by `umbra-sim dataset`.
+        #[arg(long)]
+        data: PathBuf,
+        #[arg(long, default_value = "test")]
+        split: String,
+        /// ONNX file (default: the compiled-in model).
+        #[arg(long)]
+        model: Option<PathBuf>,
+        /// Threads for tract.
+        #[arg(long, default_value_t = 1)]
+        threads: usize,
+        /// Write the metrics here as JSON.
+        #[arg(long)]
+        json: Option<PathBuf>,
     },
 }
 
@@ -196,6 +217,31 @@ fn run(cli: Cli) -> Result<(), String> {
                 t.roots.len(),
                 t.nodes.len()
             );
+        }
+        Command::EvalB {
+            data,
+            split,
+            model,
+            threads,
+            json,
+        } => {
+            let opts = models::yolo::YoloOptions { threads };
+            let mut m = match &model {
+                Some(p) => models::yolo::YoloModel::load(p, opts),
+                None => models::yolo::YoloModel::builtin(opts),
+            }
+            .map_err(|e| e.to_string())?;
+            let n = firmware::eval_b::split_images(&data, &split)?.len();
+            let b = bar(n, "images");
+            let stats = firmware::eval_b::evaluate(&mut m, &data, &split, |_, _| b.inc(1))?;
+            b.finish_and_clear();
+            let metrics = stats.metrics();
+            println!("## Method B: {} on {} / {split}\n", m.name(), data.display());
+            print!("{}", firmware::eval_b::table(&metrics));
+            if let Some(p) = json {
+                let text = serde_json::to_string_pretty(&metrics).map_err(|e| e.to_string())?;
+                std::fs::write(&p, text).map_err(|e| format!("{}: {e}", p.display()))?;
+            }
         }
         Command::EvalA {
             seed,
