@@ -49,13 +49,21 @@ fn peer(name: &str, bytes: &[u8], input: &[f32], output: &[f32]) -> Option<(f64,
     let dir = std::env::temp_dir();
     let model = dir.join(format!("umbra-bench-{name}.onnx"));
     std::fs::write(&model, bytes).ok()?;
-    let (inp, out) = (dir.join("umbra-bench-input.f32"), dir.join(format!("umbra-bench-{name}.out.f32")));
+    let (inp, out) = (
+        dir.join("umbra-bench-input.f32"),
+        dir.join(format!("umbra-bench-{name}.out.f32")),
+    );
     write_f32(&inp, input);
     write_f32(&out, output);
     let python = std::env::var("UMBRA_PYTHON").unwrap_or_else(|_| "python3".into());
     let script = concat!(env!("CARGO_MANIFEST_DIR"), "/yolo_peer.py");
     let o = std::process::Command::new(python)
-        .args([script.as_ref(), model.as_os_str(), inp.as_os_str(), out.as_os_str()])
+        .args([
+            script.as_ref(),
+            model.as_os_str(),
+            inp.as_os_str(),
+            out.as_os_str(),
+        ])
         .output()
         .ok()?;
     let s = String::from_utf8_lossy(&o.stdout).trim().to_string();
@@ -82,21 +90,38 @@ fn bench(c: &mut Criterion) {
     let mut scratch = DecodeScratch::new();
     let mut dets: heapless::Vec<Detection, 32> = heapless::Vec::new();
     g.bench_function("decode", |b| {
-        b.iter(|| decode(black_box(&output), ANCHORS, &DecodeConfig::RUNTIME, &mut scratch, &mut dets))
+        b.iter(|| {
+            decode(
+                black_box(&output),
+                ANCHORS,
+                &DecodeConfig::RUNTIME,
+                &mut scratch,
+                &mut dets,
+            )
+        })
     });
     let mut int8 = load(BUILTIN_INT8_ONNX, 1);
     int8.input_mut().copy_from_slice(&input);
     let mut fp32_2t = load(BUILTIN_ONNX, 2);
     fp32_2t.input_mut().copy_from_slice(&input);
     g.sample_size(30);
-    g.bench_function("infer_fp32", |b| b.iter(|| fp32.run(|o| o[0]).expect("runs")));
-    g.bench_function("infer_int8", |b| b.iter(|| int8.run(|o| o[0]).expect("runs")));
-    g.bench_function("infer_fp32_2_threads", |b| b.iter(|| fp32_2t.run(|o| o[0]).expect("runs")));
+    g.bench_function("infer_fp32", |b| {
+        b.iter(|| fp32.run(|o| o[0]).expect("runs"))
+    });
+    g.bench_function("infer_int8", |b| {
+        b.iter(|| int8.run(|o| o[0]).expect("runs"))
+    });
+    g.bench_function("infer_fp32_2_threads", |b| {
+        b.iter(|| fp32_2t.run(|o| o[0]).expect("runs"))
+    });
     g.finish();
 
     println!("\n| model | tract ms | onnxruntime ms | tract / onnxruntime | max output diff |");
     println!("|---|---|---|---|---|");
-    for (name, bytes, m) in [("fp32", BUILTIN_ONNX, &mut fp32), ("int8", BUILTIN_INT8_ONNX, &mut int8)] {
+    for (name, bytes, m) in [
+        ("fp32", BUILTIN_ONNX, &mut fp32),
+        ("int8", BUILTIN_INT8_ONNX, &mut int8),
+    ] {
         let ours = median_ms(&mut || {
             m.run(|o| o[0]).expect("runs");
         });
@@ -107,7 +132,9 @@ fn bench(c: &mut Criterion) {
                 ours / p,
                 line.split_whitespace().nth(3).unwrap_or("?")
             ),
-            None => println!("| {name} | {ours:.2} | not run (python3 with onnxruntime not found) | | |"),
+            None => println!(
+                "| {name} | {ours:.2} | not run (python3 with onnxruntime not found) | | |"
+            ),
         }
     }
 }

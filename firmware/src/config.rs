@@ -394,7 +394,9 @@ impl Config {
             if v.is_finite() && (lo..=hi).contains(&v) {
                 Ok(())
             } else {
-                Err(format!("method_b.{name} = {v}: must be within [{lo}, {hi}]"))
+                Err(format!(
+                    "method_b.{name} = {v}: must be within [{lo}, {hi}]"
+                ))
             }
         };
         within_b("conf", b.conf, 0.0, 1.0)?;

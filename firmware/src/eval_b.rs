@@ -7,7 +7,7 @@
 //! the YOLO label file scaled to 384 × 64 pixels. Matching ([`match_predictions`]):
 //! detections in descending score order each take the unclaimed true box of their class with
 //! the highest IoU, separately at each IoU threshold 0.50, 0.55 … 0.95. Then per class
-//! ([`ap_per_class`]): the precision/recall curve over descending score, AP as COCO's 101-point
+//! (`ap_per_class`): the precision/recall curve over descending score, AP as COCO's 101-point
 //! interpolation of the precision envelope, and P / R read at the score where the mean F1
 //! over classes (box-smoothed over 1,000 score steps) is highest. Only classes with true boxes
 //! in the split count.
@@ -54,7 +54,13 @@ pub fn match_predictions(truth: &[TrueBox], preds: &[Detection]) -> Vec<[bool; 1
         .map(|(c, b)| {
             preds
                 .iter()
-                .map(|p| if p.class == *c { box_iou(b, &xyxy(p)) } else { 0.0 })
+                .map(|p| {
+                    if p.class == *c {
+                        box_iou(b, &xyxy(p))
+                    } else {
+                        0.0
+                    }
+                })
                 .collect()
         })
         .collect();
@@ -188,7 +194,15 @@ fn compute_ap(recall: &[f64], precision: &[f64]) -> f64 {
         mpre[i] = mpre[i].max(mpre[i + 1]);
     }
     let y: Vec<f64> = (0..101)
-        .map(|i| interp(i as f64 / 100.0, &mrec, &mpre, mpre[0], mpre[mpre.len() - 1]))
+        .map(|i| {
+            interp(
+                i as f64 / 100.0,
+                &mrec,
+                &mpre,
+                mpre[0],
+                mpre[mpre.len() - 1],
+            )
+        })
         .collect();
     y.windows(2).map(|w| (w[0] + w[1]) / 2.0 * 0.01).sum()
 }
@@ -200,7 +214,9 @@ fn smooth(y: &[f64], f: f64) -> Vec<f64> {
     let mut yp = vec![y[0]; pad];
     yp.extend_from_slice(y);
     yp.extend(std::iter::repeat_n(y[y.len() - 1], pad));
-    yp.windows(nf).map(|w| w.iter().sum::<f64>() / nf as f64).collect()
+    yp.windows(nf)
+        .map(|w| w.iter().sum::<f64>() / nf as f64)
+        .collect()
 }
 
 /// Ultralytics' `ap_per_class`.
@@ -405,7 +421,15 @@ pub fn evaluate(
             .with_extension("txt");
         let truth = read_labels(&label)?;
         model
-            .run(|out| decode(out, ANCHORS, &DecodeConfig::VALIDATION, &mut scratch, &mut dets))
+            .run(|out| {
+                decode(
+                    out,
+                    ANCHORS,
+                    &DecodeConfig::VALIDATION,
+                    &mut scratch,
+                    &mut dets,
+                )
+            })
             .map_err(|e| e.to_string())?
             .map_err(|e| e.to_string())?;
         stats.add_image(&truth, &dets);
@@ -475,7 +499,10 @@ mod test {
         let m = s.metrics();
         // 0.995, not 1: Ultralytics' envelope ends at precision 0 at recall 1, and the last
         // of the 101 trapezoids is half of it (its perfect score is 0.995 too).
-        assert!((m.map50 - 0.995).abs() < 1e-9 && (m.map50_95 - 0.995).abs() < 1e-9, "{m:?}");
+        assert!(
+            (m.map50 - 0.995).abs() < 1e-9 && (m.map50_95 - 0.995).abs() < 1e-9,
+            "{m:?}"
+        );
         assert!((m.p - 1.0).abs() < 1e-9 && (m.r - 1.0).abs() < 1e-9);
         assert_eq!(m.per_class.len(), 1);
     }
@@ -501,7 +528,11 @@ mod test {
         let chair = m.per_class[0];
         assert_eq!(chair.class, "chair");
         assert!((chair.map50 - 0.5).abs() < 0.01, "{chair:?}");
-        assert_eq!(m.per_class.len(), 1, "desk has no true boxes: not a class here");
+        assert_eq!(
+            m.per_class.len(),
+            1,
+            "desk has no true boxes: not a class here"
+        );
     }
 
     #[test]

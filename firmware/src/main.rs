@@ -14,8 +14,8 @@ use firmware::cli::{Cli, Command, Common, LidarModel, Speed};
 use firmware::config::Config;
 use firmware::odom::{OdomFile, PoseState};
 use firmware::runner::{self, MethodBSetup, PoseInput, RunOptions, SecondsClock, Summary};
-use models::yolo::{YoloModel, YoloOptions};
 use firmware::source::{LidarSource, Pacing};
+use models::yolo::{YoloModel, YoloOptions};
 
 /// Exit status for bad arguments or configuration.
 const EXIT_USAGE: u8 = 2;

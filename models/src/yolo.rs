@@ -116,7 +116,9 @@ pub struct YoloModel {
 
 impl fmt::Debug for YoloModel {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.debug_struct("YoloModel").field("name", &self.name).finish()
+        f.debug_struct("YoloModel")
+            .field("name", &self.name)
+            .finish()
     }
 }
 
@@ -193,10 +195,12 @@ impl YoloModel {
             .into_optimized()
             .and_then(|m| m.into_runnable_with_options(&options))
             .map_err(|e| err(ModelErrorKind::Optimise(format!("{e:#}"))))?;
-        let state = SimpleState::new(&plan).map_err(|e| err(ModelErrorKind::Optimise(format!("{e:#}"))))?;
-        let input = Arc::new(Tensor::zero::<f32>(&INPUT_SHAPE).map_err(|e| {
-            err(ModelErrorKind::Optimise(format!("{e:#}")))
-        })?);
+        let state =
+            SimpleState::new(&plan).map_err(|e| err(ModelErrorKind::Optimise(format!("{e:#}"))))?;
+        let input = Arc::new(
+            Tensor::zero::<f32>(&INPUT_SHAPE)
+                .map_err(|e| err(ModelErrorKind::Optimise(format!("{e:#}"))))?,
+        );
         Ok(YoloModel {
             name: name.to_string(),
             state,
@@ -307,8 +311,8 @@ mod test {
 
     #[test]
     fn missing_file_is_an_io_error() {
-        let e = YoloModel::load(Path::new("/nonexistent/m.onnx"), YoloOptions::default())
-            .unwrap_err();
+        let e =
+            YoloModel::load(Path::new("/nonexistent/m.onnx"), YoloOptions::default()).unwrap_err();
         assert!(matches!(e.kind, ModelErrorKind::Io(_)), "{e}");
         assert!(e.to_string().contains("/nonexistent/m.onnx"));
     }

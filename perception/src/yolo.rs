@@ -174,7 +174,10 @@ impl fmt::Display for DecodeError {
                 "YOLO output has {len} floats, expected {OUTPUT_ROWS} × {anchors}"
             ),
             DecodeError::TooManyAnchors(a) => {
-                write!(f, "YOLO output has {a} anchors, at most {ANCHORS} supported")
+                write!(
+                    f,
+                    "YOLO output has {a} anchors, at most {ANCHORS} supported"
+                )
             }
         }
     }
@@ -357,7 +360,10 @@ mod test {
         let st = decode(&t, ANCHORS, &DecodeConfig::RUNTIME, &mut scratch, &mut out).unwrap();
         assert_eq!(st.candidates, 3);
         assert_eq!(out.len(), 2);
-        assert_eq!((out[0].class, out[0].score, out[0].cx), (ObjectClass::Chair, 0.9, 100.0));
+        assert_eq!(
+            (out[0].class, out[0].score, out[0].cx),
+            (ObjectClass::Chair, 0.9, 100.0)
+        );
         assert_eq!((out[1].class, out[1].cx), (ObjectClass::Desk, 200.0));
     }
 
@@ -382,7 +388,14 @@ mod test {
         let t = tensor(&[(7, [50.0, 10.0, 8.0, 8.0], [0.5, 0.4, 0.0005, 0.3])]);
         let mut out: Vec<Detection, 8> = Vec::new();
         let mut scratch = DecodeScratch::new();
-        decode(&t, ANCHORS, &DecodeConfig::VALIDATION, &mut scratch, &mut out).unwrap();
+        decode(
+            &t,
+            ANCHORS,
+            &DecodeConfig::VALIDATION,
+            &mut scratch,
+            &mut out,
+        )
+        .unwrap();
         let classes: std::vec::Vec<_> = out.iter().map(|d| d.class).collect();
         assert_eq!(
             classes,
@@ -393,7 +406,13 @@ mod test {
     #[test]
     fn capacity_and_max_det_bound_the_output() {
         let entries: std::vec::Vec<_> = (0..10)
-            .map(|i| (i * 20, [i as f32 * 30.0 + 10.0, 20.0, 10.0, 10.0], [0.5 + i as f32 * 0.01, 0.0, 0.0, 0.0]))
+            .map(|i| {
+                (
+                    i * 20,
+                    [i as f32 * 30.0 + 10.0, 20.0, 10.0, 10.0],
+                    [0.5 + i as f32 * 0.01, 0.0, 0.0, 0.0],
+                )
+            })
             .collect();
         let t = tensor(&entries);
         let mut out: Vec<Detection, 4> = Vec::new();
@@ -410,8 +429,17 @@ mod test {
         let mut scratch = DecodeScratch::new();
         let short = [0.0f32; 10];
         assert_eq!(
-            decode(&short, ANCHORS, &DecodeConfig::RUNTIME, &mut scratch, &mut out),
-            Err(DecodeError::BadLength { len: 10, anchors: ANCHORS })
+            decode(
+                &short,
+                ANCHORS,
+                &DecodeConfig::RUNTIME,
+                &mut scratch,
+                &mut out
+            ),
+            Err(DecodeError::BadLength {
+                len: 10,
+                anchors: ANCHORS
+            })
         );
         let big = [0.0f32; 8 * 600];
         assert_eq!(

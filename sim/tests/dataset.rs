@@ -13,7 +13,8 @@ fn tmp(name: &str) -> PathBuf {
     d
 }
 
-/// FNV-1a of every file under `dir`, by relative path.
+/// FNV-1a of every file under `dir`, by relative path; `data.yaml`'s `path:` line (the
+/// folder's own absolute path, for Ultralytics) is left out of its hash.
 fn tree_hashes(dir: &Path) -> BTreeMap<String, u64> {
     let mut out = BTreeMap::new();
     let mut stack = vec![dir.to_path_buf()];
@@ -23,7 +24,22 @@ fn tree_hashes(dir: &Path) -> BTreeMap<String, u64> {
             if p.is_dir() {
                 stack.push(p);
             } else {
-                let h = fnv(FNV_OFFSET, &std::fs::read(&p).unwrap());
+                let mut bytes = std::fs::read(&p).unwrap();
+                if p.file_name().is_some_and(|n| n == "data.yaml") {
+                    let text = String::from_utf8(bytes).unwrap();
+                    let root = std::fs::canonicalize(dir).unwrap();
+                    assert!(
+                        text.contains(&format!("path: {}\n", root.display())),
+                        "{text}"
+                    );
+                    bytes = text
+                        .lines()
+                        .filter(|l| !l.starts_with("path: "))
+                        .collect::<Vec<_>>()
+                        .join("\n")
+                        .into_bytes();
+                }
+                let h = fnv(FNV_OFFSET, &bytes);
                 out.insert(p.strip_prefix(dir).unwrap().display().to_string(), h);
             }
         }

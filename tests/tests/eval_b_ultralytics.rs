@@ -43,7 +43,10 @@ fn evaluator_agrees_with_ultralytics() {
     assert_eq!(m.images, refs["images"].as_u64().unwrap_or(100) as usize);
     let close = |what: &str, ours: f64, theirs: &serde_json::Value| {
         let theirs = theirs.as_f64().expect("number");
-        println!("{what}: ours {ours:.6} Ultralytics {theirs:.6} diff {:.2e}", (ours - theirs).abs());
+        println!(
+            "{what}: ours {ours:.6} Ultralytics {theirs:.6} diff {:.2e}",
+            (ours - theirs).abs()
+        );
         assert!((ours - theirs).abs() <= 0.01, "{what}: {ours} vs {theirs}");
     };
     close("P", m.p, &refs["p"]);

@@ -236,7 +236,11 @@ fn run(cli: Cli) -> Result<(), String> {
             let stats = firmware::eval_b::evaluate(&mut m, &data, &split, |_, _| b.inc(1))?;
             b.finish_and_clear();
             let metrics = stats.metrics();
-            println!("## Method B: {} on {} / {split}\n", m.name(), data.display());
+            println!(
+                "## Method B: {} on {} / {split}\n",
+                m.name(),
+                data.display()
+            );
             print!("{}", firmware::eval_b::table(&metrics));
             if let Some(p) = json {
                 let text = serde_json::to_string_pretty(&metrics).map_err(|e| e.to_string())?;
