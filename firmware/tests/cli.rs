@@ -252,6 +252,47 @@ fn errors_name_what_is_wrong_and_exit_2_or_1() {
 }
 
 #[test]
+fn bad_model_files_are_start_up_errors_naming_the_file() {
+    let garbage = tmp("garbage.onnx");
+    std::fs::write(&garbage, b"\x08\x07definitely not a protobuf graph").unwrap();
+    let wrong =
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../models/yolo/testdata/wrong-input.onnx");
+    let missing = tmp("missing.onnx");
+    for (file, what) in [
+        (&garbage, "not a readable ONNX model"),
+        (&wrong.to_path_buf(), "input is"),
+        (&missing, "cannot read it"),
+    ] {
+        let f = file.to_str().unwrap();
+        let out = umbra(&["run", "--frames", "1", "--model", f]);
+        assert_eq!(out.status.code(), Some(2), "{f}");
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(err.contains(f) && err.contains(what), "{f}: {err}");
+        assert!(!err.contains("panicked"), "{err}");
+    }
+    // The same file through the configuration.
+    let cfg = tmp("model.toml");
+    std::fs::write(
+        &cfg,
+        format!("[method_b]\nmodel = {:?}\n", garbage.to_str().unwrap()),
+    )
+    .unwrap();
+    let out = umbra(&["run", "--frames", "1", "--config", cfg.to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(2));
+    // Method B off: the model is not loaded at all.
+    std::fs::write(&cfg, "[method_b]\nenabled = false\n").unwrap();
+    let out = umbra(&[
+        "run",
+        "--frames",
+        "3",
+        "--quiet",
+        "--config",
+        cfg.to_str().unwrap(),
+    ]);
+    assert_eq!(out.status.code(), Some(0));
+}
+
+#[test]
 fn count_policy_keeps_and_counts_bad_packets() {
     let cap = tmp("count.bin");
     capture(
