@@ -6,7 +6,6 @@
 //! `cargo bench -p umbra-bench --bench method_a`
 
 use std::hint::black_box;
-use std::time::Instant;
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use perception::geometry::Point2;
@@ -113,17 +112,7 @@ fn bench(c: &mut Criterion) {
     g.finish();
 
     // Ratios against the peer, timed here with the same points.
-    let time = |f: &mut dyn FnMut()| {
-        let mut v: Vec<f64> = (0..200)
-            .map(|_| {
-                let t = Instant::now();
-                f();
-                t.elapsed().as_secs_f64() * 1e3
-            })
-            .collect();
-        v.sort_by(f64::total_cmp);
-        v[v.len() / 2]
-    };
+    let time = bench::median_ms;
     let mut m2 = base.clone();
     let ours_full = time(&mut || m2.run(sensor, &cfg, forest));
     let ours_dbscan = time(&mut || d.run(&points, &cfg.dbscan));

@@ -6,7 +6,6 @@
 //! printed, with the largest difference between the two runtimes' outputs.
 
 use std::hint::black_box;
-use std::time::Instant;
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use models::yolo::{BUILTIN_INT8_ONNX, BUILTIN_ONNX, YoloModel, YoloOptions};
@@ -25,18 +24,6 @@ fn scans() -> [[f32; SCAN_COLUMNS]; 3] {
     let mut frames = Vec::new();
     simulate(0, &cfg, |_, f, _| frames.push(f.ranges_m()), |_, _| {});
     [frames[2], frames[1], frames[0]]
-}
-
-fn median_ms(f: &mut dyn FnMut()) -> f64 {
-    let mut v: Vec<f64> = (0..60)
-        .map(|_| {
-            let t = Instant::now();
-            f();
-            t.elapsed().as_secs_f64() * 1e3
-        })
-        .collect();
-    v.sort_by(f64::total_cmp);
-    v[v.len() / 2]
 }
 
 fn write_f32(path: &std::path::Path, v: &[f32]) {
@@ -122,7 +109,7 @@ fn bench(c: &mut Criterion) {
         ("fp32", BUILTIN_ONNX, &mut fp32),
         ("int8", BUILTIN_INT8_ONNX, &mut int8),
     ] {
-        let ours = median_ms(&mut || {
+        let ours = bench::median_ms(&mut || {
             m.run(|o| o[0]).expect("runs");
         });
         let out: Vec<f32> = m.run(|o| o.to_vec()).expect("runs");

@@ -77,6 +77,20 @@ pub fn stream(bytes: usize, corruption: Corruption, seed: u64) -> Vec<u8> {
     corrupt(clean.chunks(42), corruption, seed).bytes
 }
 
+/// Median wall time of 200 calls of `f`, milliseconds: how the peer ratios are taken (the
+/// peers report medians too).
+pub fn median_ms(f: &mut dyn FnMut()) -> f64 {
+    let mut v: Vec<f64> = (0..200)
+        .map(|_| {
+            let t = std::time::Instant::now();
+            f();
+            t.elapsed().as_secs_f64() * 1e3
+        })
+        .collect();
+    v.sort_by(f64::total_cmp);
+    v[v.len() / 2]
+}
+
 #[cfg(test)]
 mod test {
     use super::*;

@@ -283,6 +283,17 @@ impl Default for MethodBSettings {
     }
 }
 
+/// `Ok` when `v` is a finite number in `[lo, hi]`; else the message naming `section.name`.
+fn within(section: &str, name: &str, v: f32, lo: f32, hi: f32) -> Result<(), String> {
+    if v.is_finite() && (lo..=hi).contains(&v) {
+        Ok(())
+    } else {
+        Err(format!(
+            "{section}.{name} = {v}: must be within [{lo}, {hi}]"
+        ))
+    }
+}
+
 /// The whole configuration.
 #[derive(Debug, Clone, PartialEq, Deserialize, Default)]
 #[serde(default, deny_unknown_fields)]
@@ -356,15 +367,7 @@ impl Config {
             ));
         }
         let a = &self.method_a;
-        let within = |name: &str, v: f32, lo: f32, hi: f32| {
-            if v.is_finite() && (lo..=hi).contains(&v) {
-                Ok(())
-            } else {
-                Err(format!(
-                    "method_a.{name} = {v}: must be within [{lo}, {hi}]"
-                ))
-            }
-        };
+        let within = |name: &str, v: f32, lo: f32, hi: f32| within("method_a", name, v, lo, hi);
         within("drop_fraction", a.drop_fraction, 0.0, 1.0)?;
         within("eps_min_m", a.eps_min_m, 0.01, 2.0)?;
         within("eps_max_m", a.eps_max_m, a.eps_min_m, 2.0)?;

@@ -28,3 +28,49 @@ pub fn plug_pty(link: &std::path::Path, timeout: std::time::Duration) -> serialp
     std::fs::rename(&tmp, link).expect("rename symlink");
     master
 }
+
+/// A global allocator that counts the allocations (and reallocations) made on the current
+/// thread while [`counted`] watches; everything is forwarded to the system allocator. A test
+/// binary installs it with `#[global_allocator] static A: umbra_tests::Counting =
+/// umbra_tests::Counting;`.
+pub struct Counting;
+
+thread_local! {
+    static WATCH: std::cell::Cell<bool> = const { std::cell::Cell::new(false) };
+    static COUNT: std::cell::Cell<u64> = const { std::cell::Cell::new(0) };
+}
+
+fn note_allocation() {
+    if WATCH.with(|w| w.get()) {
+        COUNT.with(|c| c.set(c.get() + 1));
+    }
+}
+
+#[allow(unsafe_code)]
+// SAFETY: every call is forwarded unchanged to the system allocator.
+unsafe impl std::alloc::GlobalAlloc for Counting {
+    unsafe fn alloc(&self, layout: std::alloc::Layout) -> *mut u8 {
+        note_allocation();
+        // SAFETY: forwarded unchanged to the system allocator.
+        unsafe { std::alloc::System.alloc(layout) }
+    }
+    unsafe fn dealloc(&self, ptr: *mut u8, layout: std::alloc::Layout) {
+        // SAFETY: forwarded unchanged to the system allocator.
+        unsafe { std::alloc::System.dealloc(ptr, layout) }
+    }
+    unsafe fn realloc(&self, ptr: *mut u8, layout: std::alloc::Layout, new: usize) -> *mut u8 {
+        note_allocation();
+        // SAFETY: forwarded unchanged to the system allocator.
+        unsafe { std::alloc::System.realloc(ptr, layout, new) }
+    }
+}
+
+/// Runs `f` and returns how many allocations this thread made meanwhile (needs [`Counting`]
+/// installed as the global allocator; 0 otherwise).
+pub fn counted(f: impl FnOnce()) -> u64 {
+    COUNT.with(|c| c.set(0));
+    WATCH.with(|w| w.set(true));
+    f();
+    WATCH.with(|w| w.set(false));
+    COUNT.with(|c| c.get())
+}

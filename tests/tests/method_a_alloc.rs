@@ -2,46 +2,15 @@
 //! simulated revolutions go through the cloud update, DBSCAN, walls, doors, merge, features and
 //! the compiled-in forest.
 
-use std::alloc::{GlobalAlloc, Layout, System};
-use std::cell::Cell;
-
 use perception::cloud::Scan;
 use perception::geometry::{Point2, Pose2};
 use perception::method_a::{MethodA, MethodAConfig};
 use sim::lds01::LIDAR_MOUNT;
 use sim::scenario::{Frame, Scenario, ScenarioConfig};
-
-struct Counting;
-
-thread_local! {
-    static WATCH: Cell<bool> = const { Cell::new(false) };
-    static COUNT: Cell<u64> = const { Cell::new(0) };
-}
-
-#[allow(unsafe_code)]
-unsafe impl GlobalAlloc for Counting {
-    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
-        if WATCH.with(|w| w.get()) {
-            COUNT.with(|c| c.set(c.get() + 1));
-        }
-        // SAFETY: forwarded unchanged to the system allocator.
-        unsafe { System.alloc(layout) }
-    }
-    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
-        // SAFETY: forwarded unchanged to the system allocator.
-        unsafe { System.dealloc(ptr, layout) }
-    }
-    unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new: usize) -> *mut u8 {
-        if WATCH.with(|w| w.get()) {
-            COUNT.with(|c| c.set(c.get() + 1));
-        }
-        // SAFETY: forwarded unchanged to the system allocator.
-        unsafe { System.realloc(ptr, layout, new) }
-    }
-}
+use umbra_tests::counted;
 
 #[global_allocator]
-static ALLOC: Counting = Counting;
+static ALLOC: umbra_tests::Counting = umbra_tests::Counting;
 
 #[test]
 fn method_a_frames_allocate_nothing() {
@@ -81,16 +50,12 @@ fn method_a_frames_allocate_nothing() {
         step(&mut m, r);
     }
     // The counter counts: one allocation while watching is seen.
-    WATCH.with(|w| w.set(true));
-    std::hint::black_box(vec![0u8; 16]);
-    WATCH.with(|w| w.set(false));
-    assert_eq!(COUNT.with(|c| c.replace(0)), 1);
-    WATCH.with(|w| w.set(true));
-    for r in &revs[30..] {
-        step(&mut m, r);
-    }
-    WATCH.with(|w| w.set(false));
-    let n = COUNT.with(|c| c.get());
+    assert_eq!(counted(|| drop(std::hint::black_box(vec![0u8; 16]))), 1);
+    let n = counted(|| {
+        for r in &revs[30..] {
+            step(&mut m, r);
+        }
+    });
     assert!(m.cloud().len() > 5_000, "cloud {}", m.cloud().len());
     assert!(!m.segments().is_empty());
     assert!(m.objects().count() > 0, "{:?}", m.candidates());

@@ -2,52 +2,13 @@
 //! constant: a counting global allocator watches this thread while simulated revolutions are
 //! encoded into the model's input, run through the compiled-in YOLOv8n and decoded.
 
-use std::alloc::{GlobalAlloc, Layout, System};
-use std::cell::Cell;
-
 use perception::raster::{RasterConfig, encode_chw_f32};
 use perception::yolo::{ANCHORS, DecodeConfig, DecodeScratch, Detection, MAX_DETECTIONS, decode};
 use sim::dataset::{DatasetConfig, simulate};
-
-struct Counting;
-
-thread_local! {
-    static WATCH: Cell<bool> = const { Cell::new(false) };
-    static COUNT: Cell<u64> = const { Cell::new(0) };
-}
-
-#[allow(unsafe_code)]
-unsafe impl GlobalAlloc for Counting {
-    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
-        if WATCH.with(|w| w.get()) {
-            COUNT.with(|c| c.set(c.get() + 1));
-        }
-        // SAFETY: forwarded unchanged to the system allocator.
-        unsafe { System.alloc(layout) }
-    }
-    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
-        // SAFETY: forwarded unchanged to the system allocator.
-        unsafe { System.dealloc(ptr, layout) }
-    }
-    unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new: usize) -> *mut u8 {
-        if WATCH.with(|w| w.get()) {
-            COUNT.with(|c| c.set(c.get() + 1));
-        }
-        // SAFETY: forwarded unchanged to the system allocator.
-        unsafe { System.realloc(ptr, layout, new) }
-    }
-}
+use umbra_tests::counted;
 
 #[global_allocator]
-static ALLOC: Counting = Counting;
-
-fn counted(f: impl FnOnce()) -> u64 {
-    COUNT.with(|c| c.set(0));
-    WATCH.with(|w| w.set(true));
-    f();
-    WATCH.with(|w| w.set(false));
-    COUNT.with(|c| c.get())
-}
+static ALLOC: umbra_tests::Counting = umbra_tests::Counting;
 
 #[test]
 fn method_b_frames_allocate_nothing_outside_tract() {
