@@ -234,6 +234,8 @@ pub fn run(
     let start = Instant::now();
     let mut summary = Summary::default();
     let mut ingest = Duration::ZERO;
+    // Host time spent processing frames (taken off the link clock).
+    let mut busy = Duration::ZERO;
     let mut state = FrameState {
         method_a: Box::new(MethodA::new()),
         ranges: [0.0; drivers::lds01::READINGS_PER_REV],
@@ -261,12 +263,16 @@ pub fn run(
                 break 'outer "time limit";
             }
         }
-        let host_us = || start.elapsed().as_micros() as u64;
+        // The link clock for staleness: host time spent waiting for bytes, not time spent
+        // processing frames (a slow frame leaves bytes queued, not the sensor silent). Files
+        // have no silence at all: no clock.
+        let link_us = |busy: Duration| start.elapsed().saturating_sub(busy).as_micros() as u64;
         let n = match source.read(&mut buf) {
             SourceRead::Data(n) => n,
             SourceRead::Idle => {
-                let now = host_us();
-                if stream.poll(now, |_| {})
+                let t_busy = Instant::now();
+                if !source.is_file()
+                    && stream.poll(link_us(busy), |_| {})
                     && emit_frame(
                         &stream,
                         source,
@@ -278,6 +284,7 @@ pub fn run(
                 {
                     break 'outer "frame limit";
                 }
+                busy += t_busy.elapsed();
                 continue;
             }
             SourceRead::End => {
@@ -308,14 +315,15 @@ pub fn run(
             source.drain_odometry(&mut p.queue);
         }
         let mut input = &buf[..n.min(READ_CHUNK)];
-        let now = host_us();
+        let now = (!source.is_file()).then(|| link_us(busy));
         loop {
             let t_feed = Instant::now();
-            let done = stream.next_revolution(&mut input, Some(now));
+            let done = stream.next_revolution(&mut input, now);
             ingest += t_feed.elapsed();
             if !done {
                 break;
             }
+            let t_busy = Instant::now();
             let limit = emit_frame(
                 &stream,
                 source,
@@ -324,6 +332,7 @@ pub fn run(
                 &mut ingest,
                 &mut state,
             )?;
+            busy += t_busy.elapsed();
             if limit {
                 break 'outer "frame limit";
             }

@@ -140,6 +140,11 @@ impl LidarSource {
         matches!(self, LidarSource::Sim { .. })
     }
 
+    /// A capture file: bytes with no timing of their own (no silence, so no staleness).
+    pub fn is_file(&self) -> bool {
+        matches!(self, LidarSource::Capture { .. })
+    }
+
     /// Reads what is available into `buf`.
     pub fn read(&mut self, buf: &mut [u8]) -> SourceRead {
         match self {
