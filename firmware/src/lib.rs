@@ -21,6 +21,7 @@ pub mod cli;
 pub mod config;
 pub mod confusion_png;
 pub mod eval_a;
+#[cfg(feature = "method-b")]
 pub mod eval_b;
 pub mod odom;
 pub mod output;

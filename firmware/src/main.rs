@@ -15,6 +15,7 @@ use firmware::config::Config;
 use firmware::odom::{OdomFile, PoseState};
 use firmware::runner::{self, MethodBSetup, PoseInput, RunOptions, SecondsClock, Summary};
 use firmware::source::{LidarSource, Pacing};
+#[cfg(feature = "method-b")]
 use models::yolo::{YoloModel, YoloOptions};
 
 /// Exit status for bad arguments or configuration.
@@ -337,8 +338,18 @@ fn run_loop(
     Ok(())
 }
 
+/// Built without Method B: says so once and runs Method A only.
+#[cfg(not(feature = "method-b"))]
+fn load_method_b(cfg: &Config, _common: &Common) -> Result<Option<MethodBSetup>, Failure> {
+    if cfg.method_b.enabled {
+        log::warn!("this umbra was built without Method B (feature method-b): Method A only");
+    }
+    Ok(None)
+}
+
 /// Loads Method B's model (`--model`, else `[method_b] model`, else the compiled-in one); a
 /// bad file is a start-up error naming it (exit 2).
+#[cfg(feature = "method-b")]
 fn load_method_b(cfg: &Config, common: &Common) -> Result<Option<MethodBSetup>, Failure> {
     if !cfg.method_b.enabled {
         if common.model.is_some() {

@@ -25,7 +25,23 @@ use perception::method_a::{MethodA, MethodAConfig};
 use perception::raster::{RasterConfig, SCAN_COLUMNS, encode_chw_f32};
 use perception::yolo::{ANCHORS, DecodeConfig, DecodeScratch, Detection, MAX_DETECTIONS, decode};
 
+#[cfg(feature = "method-b")]
 use models::yolo::YoloModel;
+
+/// Built without Method B (`--no-default-features`): no model can exist.
+#[cfg(not(feature = "method-b"))]
+#[derive(Debug)]
+pub enum YoloModel {}
+
+#[cfg(not(feature = "method-b"))]
+impl YoloModel {
+    fn input_mut(&mut self) -> &mut [f32] {
+        match *self {}
+    }
+    fn run<R>(&mut self, _f: impl FnOnce(&[f32]) -> R) -> Result<R, String> {
+        match *self {}
+    }
+}
 
 use drivers::opencr::OpencrReader;
 
