@@ -360,11 +360,8 @@ fn load_method_b(cfg: &Config, common: &Common) -> Result<Option<MethodBSetup>, 
     let opts = YoloOptions {
         threads: cfg.method_b.threads,
     };
-    let model = match common.model.as_ref().or(cfg.method_b.model.as_ref()) {
-        Some(path) => YoloModel::load(path, opts),
-        None => YoloModel::builtin(opts),
-    }
-    .map_err(|e| (EXIT_USAGE, e.to_string()))?;
+    let path = common.model.as_deref().or(cfg.method_b.model.as_deref());
+    let model = YoloModel::load_or_builtin(path, opts).map_err(|e| (EXIT_USAGE, e.to_string()))?;
     log::info!("Method B: {}", model.name());
     Ok(Some(MethodBSetup {
         model,

@@ -111,8 +111,8 @@ pub const AGREE_M: f32 = 0.3;
 /// What the loop keeps between frames, allocated once at start-up.
 struct FrameState {
     method_a: Box<MethodA>,
-    ranges: [f32; drivers::lds01::READINGS_PER_REV],
-    /// The last three revolutions' ranges by bin (0 = not drawn), slot `n % 3` for the n-th.
+    /// The last three revolutions' ranges by bin (0 = not drawn), slot `n % 3` for the n-th;
+    /// Method A reads the newest, Method B all three.
     history: [[f32; SCAN_COLUMNS]; METHOD_B_HISTORY],
     /// The robot's map pose at the middle of each of those revolutions.
     history_pose: [Pose2; METHOD_B_HISTORY],
@@ -121,6 +121,8 @@ struct FrameState {
     detections: heapless::Vec<Detection, MAX_DETECTIONS>,
     decode_scratch: Box<DecodeScratch>,
     method_b_errors: u64,
+    /// Host time spent in frames (taken off the link clock).
+    busy: Duration,
     objects: Vec<ObjectOut>,
     walls: Vec<WallOut>,
     doors: Vec<DoorOut>,
@@ -251,16 +253,15 @@ pub fn run(
     let mut summary = Summary::default();
     let mut ingest = Duration::ZERO;
     // Host time spent processing frames (taken off the link clock).
-    let mut busy = Duration::ZERO;
     let mut state = FrameState {
         method_a: Box::new(MethodA::new()),
-        ranges: [0.0; drivers::lds01::READINGS_PER_REV],
         history: [[0.0; SCAN_COLUMNS]; METHOD_B_HISTORY],
         history_pose: [Pose2::IDENTITY; METHOD_B_HISTORY],
         revolutions: 0,
         detections: heapless::Vec::new(),
         decode_scratch: Box::new(DecodeScratch::new()),
         method_b_errors: 0,
+        busy: Duration::ZERO,
         objects: Vec::with_capacity(OUT_CAPACITY),
         walls: Vec::with_capacity(perception::walls::MAX_SEGMENTS),
         doors: Vec::with_capacity(perception::doors::MAX_DOORS),
@@ -286,9 +287,8 @@ pub fn run(
         let n = match source.read(&mut buf) {
             SourceRead::Data(n) => n,
             SourceRead::Idle => {
-                let t_busy = Instant::now();
                 if !source.is_file()
-                    && stream.poll(link_us(busy), |_| {})
+                    && stream.poll(link_us(state.busy), |_| {})
                     && emit_frame(
                         &stream,
                         source,
@@ -300,7 +300,6 @@ pub fn run(
                 {
                     break 'outer "frame limit";
                 }
-                busy += t_busy.elapsed();
                 continue;
             }
             SourceRead::End => {
@@ -331,7 +330,7 @@ pub fn run(
             source.drain_odometry(&mut p.queue);
         }
         let mut input = &buf[..n.min(READ_CHUNK)];
-        let now = (!source.is_file()).then(|| link_us(busy));
+        let now = (!source.is_file()).then(|| link_us(state.busy));
         loop {
             let t_feed = Instant::now();
             let done = stream.next_revolution(&mut input, now);
@@ -339,7 +338,6 @@ pub fn run(
             if !done {
                 break;
             }
-            let t_busy = Instant::now();
             let limit = emit_frame(
                 &stream,
                 source,
@@ -348,7 +346,6 @@ pub fn run(
                 &mut ingest,
                 &mut state,
             )?;
-            busy += t_busy.elapsed();
             if limit {
                 break 'outer "frame limit";
             }
@@ -517,7 +514,8 @@ fn emit_frame(
     state.objects.clear();
     state.walls.clear();
     state.doors.clear();
-    for (r, reading) in state.ranges.iter_mut().zip(rev.readings.iter()) {
+    let slot = (state.revolutions % METHOD_B_HISTORY as u64) as usize;
+    for (r, reading) in state.history[slot].iter_mut().zip(rev.readings.iter()) {
         *r = if reading.valid { reading.range_m } else { 0.0 };
     }
     let method_a_ms = match opts.method_a.as_ref() {
@@ -525,7 +523,7 @@ fn emit_frame(
             let m = &mut state.method_a;
             m.add_scan(
                 &Scan {
-                    ranges: &state.ranges,
+                    ranges: &state.history[slot],
                     start: pose,
                     end,
                     mount: *mount,
@@ -569,8 +567,6 @@ fn emit_frame(
         }
         None => None,
     };
-    let slot = (state.revolutions % 3) as usize;
-    state.history[slot].copy_from_slice(&state.ranges[..SCAN_COLUMNS]);
     state.history_pose[slot] = midway(&pose, &end);
     state.revolutions += 1;
     let method_b_ms = match opts.method_b.as_mut() {
@@ -635,5 +631,7 @@ fn emit_frame(
         line.write_to(w)?;
     }
     *ingest = Duration::ZERO;
+    // Output errors end the run, so only this path needs the frame's time.
+    state.busy += t_frame.elapsed();
     Ok(opts.frames.is_some_and(|n| summary.frames >= n))
 }

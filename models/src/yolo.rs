@@ -132,6 +132,14 @@ impl YoloModel {
         Self::from_bytes(BUILTIN_ONNX, BUILTIN_NAME, opts)
     }
 
+    /// Loads `path`, or the compiled-in model when there is none.
+    pub fn load_or_builtin(path: Option<&Path>, opts: YoloOptions) -> Result<Self, ModelError> {
+        match path {
+            Some(p) => Self::load(p, opts),
+            None => Self::builtin(opts),
+        }
+    }
+
     /// Loads a model file.
     pub fn load(path: &Path, opts: YoloOptions) -> Result<Self, ModelError> {
         let name = path.display().to_string();

@@ -253,33 +253,23 @@ pub fn decode<const N: usize>(
             stats.non_finite += 1;
             continue;
         }
-        if cfg.multi_label {
-            for c in 0..NUM_CLASSES {
-                let s = at(4 + c, a);
-                if s > cfg.conf {
-                    // Capacity is anchors × classes: cannot overflow.
-                    let _ = cands.push(Candidate {
-                        score: s,
-                        anchor: a as u16,
-                        class: c as u8,
-                    });
-                }
-            }
-        } else {
-            let mut best = 0;
-            for c in 1..NUM_CLASSES {
-                if at(4 + c, a) > at(4 + best, a) {
-                    best = c;
-                }
-            }
-            let s = at(4 + best, a);
-            if s > cfg.conf {
+        let mut push = |c: usize| {
+            let score = at(4 + c, a);
+            if score > cfg.conf {
+                // Capacity is anchors × classes: cannot overflow.
                 let _ = cands.push(Candidate {
-                    score: s,
+                    score,
                     anchor: a as u16,
-                    class: best as u8,
+                    class: c as u8,
                 });
             }
+        };
+        if cfg.multi_label {
+            (0..NUM_CLASSES).for_each(&mut push);
+        } else {
+            let best =
+                (1..NUM_CLASSES).fold(0, |b, c| if at(4 + c, a) > at(4 + b, a) { c } else { b });
+            push(best);
         }
     }
     stats.candidates = cands.len();

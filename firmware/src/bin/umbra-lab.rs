@@ -226,11 +226,8 @@ fn run(cli: Cli) -> Result<(), String> {
             json,
         } => {
             let opts = models::yolo::YoloOptions { threads };
-            let mut m = match &model {
-                Some(p) => models::yolo::YoloModel::load(p, opts),
-                None => models::yolo::YoloModel::builtin(opts),
-            }
-            .map_err(|e| e.to_string())?;
+            let mut m = models::yolo::YoloModel::load_or_builtin(model.as_deref(), opts)
+                .map_err(|e| e.to_string())?;
             let n = firmware::eval_b::split_images(&data, &split)?.len();
             let b = bar(n, "images");
             let stats = firmware::eval_b::evaluate(&mut m, &data, &split, |_, _| b.inc(1))?;
