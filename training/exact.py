@@ -5,9 +5,14 @@ become 96 x 416 letterboxes, grey rows and columns all round, which the network 
 training (train batches are unpadded) nor at run time. Measured on a 7-epoch model: val mAP50
 0.0001 letterboxed vs the real figure unpadded. These subclasses set the val batch shape
 back to 64 x 384; nothing else changes.
+
+The trainer also puts `mirror.MirrorRoom` first in the training transforms, with the
+probability in `ExactTrainer.mirror_p` (0 = off).
 """
 
 from ultralytics.models.yolo.detect import DetectionTrainer, DetectionValidator
+
+from mirror import MirrorRoom
 
 
 def _unpad(ds):
@@ -24,6 +29,12 @@ class ExactValidator(DetectionValidator):
 
 
 class ExactTrainer(DetectionTrainer):
+    mirror_p = 0.0
+
     def build_dataset(self, img_path, mode="train", batch=None):
         ds = super().build_dataset(img_path, mode, batch)
-        return _unpad(ds) if mode == "val" else ds
+        if mode == "val":
+            return _unpad(ds)
+        if self.mirror_p > 0.0:
+            ds.transforms.insert(0, MirrorRoom(self.mirror_p))
+        return ds

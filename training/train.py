@@ -3,11 +3,12 @@
     python training/train.py --data DATASET/data.yaml --epochs 12 --batch 32 --seed 0 --name small
 
 Augmentations are chosen by physics, not by Ultralytics' defaults: every colour, geometric and
-composite augmentation is off. In particular Ultralytics' left-right flip is NOT a mirrored
-room for our raster: it mirrors all 384 columns, moving the 24 zero padding columns to the left
-and shifting every bearing by 24°. (A valid mirror, column d -> (360 - d) mod 360 with the
-padding kept on the right, needs a custom transform; see the production-model issue.)
-The up-down flip mirrors range, which no real scan does.
+composite augmentation of Ultralytics is off, and a mirrored room (`mirror.py`, p = 0.5) is on.
+Ultralytics' left-right flip is NOT a mirrored room for our raster: it mirrors all 384 columns,
+moving the 24 zero padding columns to the left and shifting every bearing by 24°. The up-down
+flip mirrors range, which no real scan does. Colour (HSV) changes would alter the channel
+intensities that encode which revolution a return belongs to; scale/translate would change
+range or bearing per pixel, which the sensor fixes; mosaic/mixup/cutmix paste scans together.
 """
 
 import argparse
@@ -27,6 +28,25 @@ OFF = dict(
 )
 
 
+def train(data: Path, epochs: int, batch: int = 32, seed: int = 0, device: str = "cpu",
+          workers: int = 2, name: str = "small", resume: bool = False, mirror: float = 0.5,
+          init: Path | None = None) -> Path:
+    """Train (or resume) one run; returns its weights folder."""
+    ExactTrainer.mirror_p = mirror
+    weights = HERE / "runs" / name / "weights"
+    if resume:
+        YOLO(str(weights / "last.pt")).train(resume=True, trainer=ExactTrainer)
+    else:
+        YOLO(str(HERE / "yolov8n-umbra.yaml")).train(
+            data=str(Path(data).resolve()), imgsz=384, rect=True, epochs=epochs, batch=batch,
+            workers=workers, device=device, seed=seed, deterministic=True,
+            pretrained=str(init) if init else False, amp=device != "cpu", plots=False,
+            project=str(HERE / "runs"), name=name, exist_ok=True, val=True,
+            trainer=ExactTrainer, **OFF,
+        )
+    return weights
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--data", required=True, help="data.yaml written by umbra-sim dataset")
@@ -36,23 +56,16 @@ def main() -> None:
     ap.add_argument("--device", default="cpu")
     ap.add_argument("--workers", type=int, default=2)
     ap.add_argument("--name", default="small")
+    ap.add_argument("--mirror", type=float, default=0.5,
+                    help="probability of a mirrored room (training/mirror.py); 0 = off")
+    ap.add_argument("--init", type=Path, help="start from these weights (e.g. the committed .pt)")
     ap.add_argument("--resume", action="store_true", help="continue runs/NAME/weights/last.pt")
     a = ap.parse_args()
 
     t0 = time.time()
-    last = HERE / "runs" / a.name / "weights" / "last.pt"
-    if a.resume:
-        model = YOLO(str(last))
-        model.train(resume=True, trainer=ExactTrainer)
-    else:
-        model = YOLO(str(HERE / "yolov8n-umbra.yaml"))
-        model.train(
-            data=str(Path(a.data).resolve()), imgsz=384, rect=True, epochs=a.epochs,
-            batch=a.batch, workers=a.workers, device=a.device, seed=a.seed, deterministic=True,
-            pretrained=False, amp=a.device != "cpu", plots=False, project=str(HERE / "runs"),
-            name=a.name, exist_ok=True, val=True, trainer=ExactTrainer, **OFF,
-        )
-    print(f"trained in {time.time() - t0:.0f} s: {HERE / 'runs' / a.name / 'weights'}")
+    w = train(Path(a.data), a.epochs, a.batch, a.seed, a.device, a.workers, a.name, a.resume,
+              a.mirror, a.init)
+    print(f"trained in {time.time() - t0:.0f} s: {w}")
 
 
 if __name__ == "__main__":

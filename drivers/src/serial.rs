@@ -213,6 +213,12 @@ impl SerialLink {
         self.port.is_some()
     }
 
+    /// Bytes the port has received that nobody has read yet (`None` while closed or when the
+    /// driver cannot tell): how far a reader lags behind the device.
+    pub fn backlog_bytes(&self) -> Option<u32> {
+        self.port.as_ref()?.inner().bytes_to_read().ok()
+    }
+
     /// Counters.
     pub fn stats(&self) -> &LinkStats {
         &self.stats

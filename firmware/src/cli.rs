@@ -23,6 +23,19 @@ pub enum Command {
     /// Fit the compass's hard-iron offset from readings taken while the robot turns, and write
     /// it to the configuration.
     CalibrateCompass(CalibrateArgs),
+    /// Print the deadline and power table of a finished run from its `--jsonl` output.
+    Report(ReportArgs),
+}
+
+/// `umbra report`.
+#[derive(Debug, Args)]
+pub struct ReportArgs {
+    /// The run's JSON Lines (`--jsonl`).
+    pub jsonl: PathBuf,
+    /// The run's configuration, for its stage budgets (default: shares of the lines'
+    /// deadline).
+    #[arg(long, value_name = "PATH")]
+    pub config: Option<PathBuf>,
 }
 
 /// `umbra calibrate-compass`.
@@ -116,6 +129,10 @@ pub struct RunArgs {
     /// Seed of the simulated room (simulated robot only).
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
+    /// Simulated robot only: `1` runs at the sensor's pace (5 revolutions a second), `max`
+    /// as fast as it can (soaks, deadline reports).
+    #[arg(long, value_enum, default_value = "1")]
+    pub speed: Speed,
     /// Shared options.
     #[command(flatten)]
     pub common: Common,

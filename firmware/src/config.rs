@@ -11,6 +11,22 @@
 //! [runtime]
 //! deadline_ms = 250        # per-frame budget
 //!
+//! [runtime.budget_ms]      # per-stage budgets; each defaults to a share of the deadline
+//! ingest = 10              # 4 %
+//! pose = 5                 # 2 %
+//! method_a = 80            # 32 %
+//! method_b = 140           # 56 %
+//! output = 15              # 6 %
+//!
+//! [power]
+//! budget_w = 10.0
+//! source = "auto"          # or "ina219", "pmic", "model"
+//! board = "auto"           # the model's board: "pi5", "pi3b+", "pi3b"; auto: device tree
+//! lidar_w = 2.0            # what the LiDAR adds in the model
+//! ina219_bus = "/dev/i2c-1"
+//! ina219_address = 0x40
+//! shunt_ohm = 0.1
+//!
 //! [odometry]               # TurtleBot3 Burger defaults
 //! wheel_radius_m = 0.033
 //! wheel_separation_m = 0.160
@@ -106,12 +122,33 @@ impl Default for LidarSettings {
 pub struct RuntimeSettings {
     /// Per-frame deadline, milliseconds.
     pub deadline_ms: f64,
+    /// Per-stage budgets.
+    pub budget_ms: StageBudgets,
 }
 
 impl Default for RuntimeSettings {
     fn default() -> Self {
-        RuntimeSettings { deadline_ms: 250.0 }
+        RuntimeSettings {
+            deadline_ms: 250.0,
+            budget_ms: StageBudgets::default(),
+        }
     }
+}
+
+/// `[runtime.budget_ms]`: each stage's budget, ms; unset ones are a share of the deadline.
+#[derive(Debug, Clone, Copy, PartialEq, Deserialize, Default)]
+#[serde(default, deny_unknown_fields)]
+pub struct StageBudgets {
+    /// Ingest (4 % of the deadline).
+    pub ingest: Option<f64>,
+    /// Pose (2 %).
+    pub pose: Option<f64>,
+    /// Method A (32 %).
+    pub method_a: Option<f64>,
+    /// Method B (56 %).
+    pub method_b: Option<f64>,
+    /// Output (6 %).
+    pub output: Option<f64>,
 }
 
 /// `[odometry]`.
@@ -312,6 +349,8 @@ pub struct Config {
     pub method_a: MethodASettings,
     /// Method B.
     pub method_b: MethodBSettings,
+    /// Power budget and source.
+    pub power: crate::power::PowerSettings,
 }
 
 /// A configuration error, naming the file and field.
@@ -417,7 +456,45 @@ impl Config {
                 "runtime.deadline_ms = {d}: must be within (0, 10000]"
             ));
         }
+        let b = self.budgets();
+        let given = &self.runtime.budget_ms;
+        for (name, v) in [
+            ("ingest", given.ingest),
+            ("pose", given.pose),
+            ("method_a", given.method_a),
+            ("method_b", given.method_b),
+            ("output", given.output),
+        ] {
+            if let Some(v) = v
+                && !(v.is_finite() && v > 0.0 && v <= d)
+            {
+                return Err(format!(
+                    "runtime.budget_ms.{name} = {v}: must be within (0, deadline_ms = {d}]"
+                ));
+            }
+        }
+        let sum = b.ingest_ms + b.pose_ms + b.method_a_ms + b.method_b_ms + b.output_ms;
+        if sum > d * (1.0 + 1e-9) {
+            return Err(format!(
+                "runtime.budget_ms: the stage budgets add up to {sum} ms, over runtime.deadline_ms = {d}"
+            ));
+        }
+        self.power.validate()?;
         Ok(())
+    }
+
+    /// The deadline and the stage budgets, unset ones as their share of the deadline.
+    pub fn budgets(&self) -> crate::deadline::Budgets {
+        let d = self.runtime.deadline_ms;
+        let b = &self.runtime.budget_ms;
+        crate::deadline::Budgets {
+            deadline_ms: d,
+            ingest_ms: b.ingest.unwrap_or(d * 0.04),
+            pose_ms: b.pose.unwrap_or(d * 0.02),
+            method_a_ms: b.method_a.unwrap_or(d * 0.32),
+            method_b_ms: b.method_b.unwrap_or(d * 0.56),
+            output_ms: b.output.unwrap_or(d * 0.06),
+        }
     }
 
     /// A pose filter with these settings; a calibration given (hard iron, field reference)

@@ -14,16 +14,22 @@
 //! | [`eval_a`]   | Method A scored against the simulator's truth; forest training rows |
 //! | [`eval_b`]     | Method B scored on a dataset split: P, R, mAP50, mAP50-95 as Ultralytics does |
 //! | [`confusion_png`] | the evaluation's confusion matrix as a PNG              |
+//! | [`deadline`] | stage histograms, budgets, the overrun policy, the deadline table |
+//! | [`power`]    | watts from an INA219, the Pi 5 PMIC or a CPU-time model; the budget |
+//! | [`report`]   | `umbra report OUT.jsonl`: the deadline and power table of a run |
 #![deny(unsafe_code, missing_docs)]
 
 pub mod calibrate;
 pub mod cli;
 pub mod config;
 pub mod confusion_png;
+pub mod deadline;
 pub mod eval_a;
 #[cfg(feature = "method-b")]
 pub mod eval_b;
 pub mod odom;
 pub mod output;
+pub mod power;
+pub mod report;
 pub mod runner;
 pub mod source;

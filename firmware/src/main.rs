@@ -13,6 +13,7 @@ use firmware::calibrate;
 use firmware::cli::{Cli, Command, Common, LidarModel, Speed};
 use firmware::config::Config;
 use firmware::odom::{OdomFile, PoseState};
+use firmware::power::PowerMeter;
 use firmware::runner::{self, MethodBSetup, PoseInput, RunOptions, SecondsClock, Summary};
 use firmware::source::{LidarSource, Pacing};
 #[cfg(feature = "method-b")]
@@ -71,10 +72,17 @@ fn dispatch(cli: Cli) -> Result<(), Failure> {
                     "no [compass] hard_iron_ut in the configuration: compass readings ignored (run `umbra calibrate-compass`)"
                 );
             }
-            let pacing = if source.is_simulated() {
-                Pacing::RealTime
-            } else {
-                Pacing::Max // the port paces itself
+            let pacing = match (source.is_simulated(), args.speed) {
+                (true, Speed::RealTime) => Pacing::RealTime,
+                (true, Speed::Max) => Pacing::Max,
+                (false, speed) => {
+                    if speed == Speed::Max {
+                        log::warn!(
+                            "--speed max applies to the simulated robot only: the port paces itself"
+                        );
+                    }
+                    Pacing::Max // the port paces itself
+                }
             };
             let from_sim = opencr.is_none() && source.is_simulated();
             let board = opencr.map(|board| PoseInput {
@@ -194,6 +202,16 @@ fn dispatch(cli: Cli) -> Result<(), Failure> {
                     c.hard_iron.x_ut, c.hard_iron.y_ut, c.hard_iron.field_ut, c.vertical_ut
                 ),
             }
+            Ok(())
+        }
+        Command::Report(args) => {
+            let cfg = match &args.config {
+                Some(path) => Some(Config::load(path).map_err(|e| (EXIT_USAGE, e.to_string()))?),
+                None => None,
+            };
+            let table = firmware::report::from_jsonl(&args.jsonl, cfg.as_ref())
+                .map_err(|m| (EXIT_USAGE, m))?;
+            print!("{table}");
             Ok(())
         }
         Command::Replay(args) => {
@@ -316,12 +334,16 @@ fn run_loop(
         log::warn!("cannot install the Ctrl-C handler ({e}); Ctrl-C will stop without a summary");
     }
     let method_b = load_method_b(cfg, common)?;
+    let power = PowerMeter::start(&cfg.power).map_err(|e| (EXIT_USAGE, e))?;
+    log::info!("power: {}", power.source());
     let opts = RunOptions {
         frames: common.frames,
         seconds: common.seconds,
         seconds_clock,
         pacing,
-        deadline_ms: cfg.runtime.deadline_ms,
+        budgets: cfg.budgets(),
+        power: Some(power),
+        power_budget_w: cfg.power.budget_w,
         jsonl,
         stats,
         stop,
@@ -393,4 +415,5 @@ fn print_summary(s: &Summary) {
         s.link.1,
         s.deadline_missed
     );
+    eprint!("{}", s.table());
 }

@@ -77,7 +77,9 @@ pub struct TimingOut {
     /// revolutions, before the raster has its three).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub method_b: Option<f64>,
-    /// Whole frame.
+    /// Writing the previous frame's output line (a line cannot carry its own write time).
+    pub output: f64,
+    /// Whole frame: the stages above.
     pub total: f64,
 }
 
@@ -113,6 +115,17 @@ pub struct FaultsOut {
     pub compass_errors: u64,
     /// Method B frames that failed (raster, inference or decoding error): no B objects.
     pub method_b_errors: u64,
+    /// Frames over the deadline.
+    pub deadline_missed: u64,
+    /// Degraded frames (work shed by the overrun policy).
+    pub degraded_frames: u64,
+    /// Frames without Method B by the overrun policy (no room left, or decimated).
+    pub method_b_skipped: u64,
+    /// Frames whose cloud work was shrunk by the overrun policy.
+    pub cloud_shrunk: u64,
+    /// Frames that ended with the loop behind the LiDAR (more than a revolution of bytes
+    /// queued, or the simulated sensor ahead by more than a revolution).
+    pub behind_lidar: u64,
 }
 
 impl FaultsOut {
@@ -131,8 +144,7 @@ impl FaultsOut {
             lidar_invalid_readings: invalid_readings,
             lidar_link_lost: link.0,
             lidar_link_reopened: link.1,
-            compass_errors: 0,
-            method_b_errors: 0,
+            ..FaultsOut::default()
         }
     }
 }
@@ -146,6 +158,9 @@ pub struct LidarOut {
     pub packets: u8,
     /// Valid readings of 360.
     pub valid: u32,
+    /// Bytes queued on the port when the frame ended (a real LiDAR's queue depth).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub backlog_bytes: Option<u32>,
 }
 
 /// One output line (`interfaces.md` §3).
@@ -173,6 +188,8 @@ pub struct OutputLine<'a> {
     pub degraded: bool,
     /// Power draw, W (`null`: no power source yet).
     pub power_w: Option<f64>,
+    /// Where `power_w` comes from.
+    pub power_source: &'a str,
     /// Cumulative fault counters.
     pub faults: FaultsOut,
     /// The revolution behind this frame.
@@ -187,20 +204,38 @@ impl OutputLine<'_> {
     }
 }
 
-/// The human-readable per-revolution line.
+/// The human-readable per-revolution line (a `Display`: written straight to its sink, no
+/// allocation).
+pub struct StatsLine<'a> {
+    /// Frame number.
+    pub frame: u64,
+    /// The revolution.
+    pub rev: &'a Revolution,
+}
+
+impl core::fmt::Display for StatsLine<'_> {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        let rev = self.rev;
+        write!(
+            f,
+            "frame {:>6}  t {:>9.3} s  {:>5.1} rpm  packets {:>2}/60  valid {:>3}/360  no-return {:>3}  ",
+            self.frame,
+            rev.first_ray_time_s(),
+            rev.rpm,
+            rev.packets,
+            rev.valid_count(),
+            rev.no_return_count(),
+        )?;
+        match rev.range_stats() {
+            Some((lo, mean, hi)) => write!(f, "range {lo:.2}–{hi:.2} m (mean {mean:.2})"),
+            None => f.write_str("no valid range"),
+        }
+    }
+}
+
+/// The human-readable per-revolution line as a string.
 pub fn stats_line(frame: u64, rev: &Revolution) -> String {
-    let ranges = match rev.range_stats() {
-        Some((lo, mean, hi)) => format!("range {lo:.2}–{hi:.2} m (mean {mean:.2})"),
-        None => "no valid range".to_owned(),
-    };
-    format!(
-        "frame {frame:>6}  t {:>9.3} s  {:>5.1} rpm  packets {:>2}/60  valid {:>3}/360  no-return {:>3}  {ranges}",
-        rev.first_ray_time_s(),
-        rev.rpm,
-        rev.packets,
-        rev.valid_count(),
-        rev.no_return_count(),
-    )
+    StatsLine { frame, rev }.to_string()
 }
 
 #[cfg(test)]
@@ -221,12 +256,14 @@ mod test {
                 pose: 0.0,
                 method_a: None,
                 method_b: None,
+                output: 0.0,
                 total: 0.2,
             },
             deadline_ms: 250.0,
             deadline_missed: false,
             degraded: false,
             power_w: None,
+            power_source: "model",
             faults: FaultsOut::default(),
             lidar: LidarOut::default(),
         };

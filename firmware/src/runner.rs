@@ -47,9 +47,13 @@ use drivers::opencr::OpencrReader;
 
 use crate::odom::{OdomFile, OdomRecord, PoseState};
 
-use crate::output::{
-    DoorOut, FaultsOut, LidarOut, ObjectOut, OutputLine, PoseOut, TimingOut, WallOut, stats_line,
+use crate::deadline::{
+    Budgets, DeadlineRecord, FrameTimes, Policy, PowerVerdict, SHRINK_DROP_FRACTION,
 };
+use crate::output::{
+    DoorOut, FaultsOut, LidarOut, ObjectOut, OutputLine, PoseOut, StatsLine, TimingOut, WallOut,
+};
+use crate::power::PowerMeter;
 use crate::source::{LidarSource, Pacing, SourceRead};
 
 /// Bytes read from the source at a time (~0.2 revolution; a capture is read in these too).
@@ -74,8 +78,12 @@ pub struct RunOptions {
     pub seconds_clock: SecondsClock,
     /// Pacing.
     pub pacing: Pacing,
-    /// Per-frame budget, ms.
-    pub deadline_ms: f64,
+    /// The deadline and the stage budgets.
+    pub budgets: Budgets,
+    /// Where the watts come from (`None`: no power figures).
+    pub power: Option<PowerMeter>,
+    /// The power budget, W.
+    pub power_budget_w: f64,
     /// JSON lines go here.
     pub jsonl: Option<Box<dyn Write>>,
     /// Statistics lines go here (`None`: quiet).
@@ -123,6 +131,18 @@ struct FrameState {
     method_b_errors: u64,
     /// Host time spent in frames (taken off the link clock).
     busy: Duration,
+    /// When the loop started.
+    start: Instant,
+    /// The overrun policy's memory.
+    policy: Policy,
+    /// Stage histograms and counters.
+    record: DeadlineRecord,
+    /// Time it took to write the previous frame's line, ms.
+    last_output_ms: f64,
+    /// Sum, count and peak of the power figures.
+    power_sum: f64,
+    power_n: u64,
+    power_peak: f64,
     objects: Vec<ObjectOut>,
     walls: Vec<WallOut>,
     doors: Vec<DoorOut>,
@@ -239,7 +259,27 @@ pub struct Summary {
     pub wall_seconds: f64,
     /// Why the run stopped.
     pub stop_reason: &'static str,
+    /// Stage histograms, misses, degraded frames.
+    pub deadlines: DeadlineRecord,
+    /// The deadline and stage budgets.
+    pub budgets: Option<Budgets>,
+    /// The power verdict.
+    pub power: PowerVerdict,
 }
+
+impl Summary {
+    /// The deadline and power table of `interfaces.md` §4.
+    pub fn table(&self) -> String {
+        match &self.budgets {
+            Some(b) => crate::deadline::table(&self.deadlines, b, &self.power),
+            None => String::new(),
+        }
+    }
+}
+
+/// Bytes of one LDS-01 revolution on the wire (60 packets of 42 bytes): more than this queued
+/// on the port means the loop has fallen behind the LiDAR.
+pub const REVOLUTION_BYTES: u32 = 60 * drivers::lds01::PACKET_LEN as u32;
 
 /// Runs the loop until a limit, the end of the source, or the stop flag.
 pub fn run(
@@ -262,6 +302,13 @@ pub fn run(
         decode_scratch: Box::new(DecodeScratch::new()),
         method_b_errors: 0,
         busy: Duration::ZERO,
+        start,
+        policy: Policy::default(),
+        record: DeadlineRecord::default(),
+        last_output_ms: 0.0,
+        power_sum: 0.0,
+        power_n: 0,
+        power_peak: 0.0,
         objects: Vec::with_capacity(OUT_CAPACITY),
         walls: Vec::with_capacity(perception::walls::MAX_SEGMENTS),
         doors: Vec::with_capacity(perception::doors::MAX_DOORS),
@@ -362,6 +409,17 @@ pub fn run(
     summary.sensor_seconds = stream.sensor_time_s();
     summary.wall_seconds = start.elapsed().as_secs_f64();
     summary.stop_reason = reason;
+    summary.deadlines = state.record.clone();
+    summary.budgets = Some(opts.budgets);
+    summary.power = PowerVerdict {
+        mean_w: (state.power_n > 0).then(|| state.power_sum / state.power_n as f64),
+        peak_w: (state.power_n > 0).then_some(state.power_peak),
+        budget_w: opts.power_budget_w,
+        source: opts
+            .power
+            .as_ref()
+            .map_or("none".to_owned(), |p| p.source().to_owned()),
+    };
     if let Some(w) = opts.jsonl.as_mut() {
         w.flush()?;
     }
@@ -369,6 +427,23 @@ pub fn run(
         w.flush()?;
     }
     Ok(summary)
+}
+
+/// Whether the loop has fallen more than a revolution behind the LiDAR: bytes queued on a
+/// port, or (simulated robot paced in real time) wall time ahead of the sensor clock.
+fn behind_lidar(
+    source: &LidarSource,
+    pacing: Pacing,
+    stream: &Lds01Stream,
+    start: &Instant,
+    period_s: f64,
+) -> bool {
+    if let Some(queued) = source.backlog_bytes() {
+        return queued > REVOLUTION_BYTES;
+    }
+    source.is_simulated()
+        && pacing == Pacing::RealTime
+        && start.elapsed().as_secs_f64() - stream.sensor_time_s() > period_s
 }
 
 /// A Method A object of the output line; `id` is its place in the line.
@@ -483,7 +558,7 @@ fn emit_frame(
     summary.invalid_readings += u64::from(rev.packets) * 6 - u64::from(valid);
 
     if let Some(w) = opts.stats.as_mut() {
-        writeln!(w, "{}", stats_line(frame, rev))?;
+        writeln!(w, "{}", StatsLine { frame, rev })?;
     }
     let t = rev.first_ray_time_s().max(0.0);
     let t_pose = Instant::now();
@@ -518,8 +593,18 @@ fn emit_frame(
     for (r, reading) in state.history[slot].iter_mut().zip(rev.readings.iter()) {
         *r = if reading.valid { reading.range_m } else { 0.0 };
     }
+    let shrink = opts.method_a.is_some() && state.policy.before_method_a(&opts.budgets);
     let method_a_ms = match opts.method_a.as_ref() {
         Some((cfg, mount)) => {
+            // Overrun policy step 2: age more of the cloud so clustering sees fewer points.
+            let mut shrunk;
+            let cfg = if shrink {
+                shrunk = *cfg;
+                shrunk.cloud.drop_fraction = shrunk.cloud.drop_fraction.max(SHRINK_DROP_FRACTION);
+                &shrunk
+            } else {
+                cfg
+            };
             let m = &mut state.method_a;
             m.add_scan(
                 &Scan {
@@ -563,14 +648,25 @@ fn emit_frame(
                     d.score,
                 ));
             }
-            Some(t_a.elapsed().as_secs_f64() * 1e3)
+            let ms = t_a.elapsed().as_secs_f64() * 1e3;
+            state.policy.method_a_took(ms);
+            Some(ms)
         }
         None => None,
     };
     state.history_pose[slot] = midway(&pose, &end);
     state.revolutions += 1;
+    let behind = behind_lidar(source, opts.pacing, stream, &state.start, period);
+    let backlog_bytes = source.backlog_bytes();
+    let elapsed_ms = ingest.as_secs_f64() * 1e3 + t_frame.elapsed().as_secs_f64() * 1e3;
+    // Overrun policy step 1: no room left for Method B, or decimated while behind.
+    let run_b = opts.method_b.is_some() && state.revolutions >= 3;
+    let skip_b = run_b
+        && state
+            .policy
+            .before_method_b(&opts.budgets, elapsed_ms, behind);
     let method_b_ms = match opts.method_b.as_mut() {
-        Some(b) if state.revolutions >= 3 => {
+        Some(b) if run_b && !skip_b => {
             let t_b = Instant::now();
             if let Err(e) = method_b_frame(b, state) {
                 if state.method_b_errors == 0 {
@@ -578,16 +674,44 @@ fn emit_frame(
                 }
                 state.method_b_errors += 1;
             }
-            Some(t_b.elapsed().as_secs_f64() * 1e3)
+            let ms = t_b.elapsed().as_secs_f64() * 1e3;
+            state.policy.method_b_took(ms);
+            Some(ms)
         }
         _ => None,
     };
     let ingest_ms = ingest.as_secs_f64() * 1e3;
-    let total_ms = ingest_ms + t_frame.elapsed().as_secs_f64() * 1e3;
-    let missed = total_ms > opts.deadline_ms;
+    let output_ms = state.last_output_ms;
+    let total_ms = ingest_ms + t_frame.elapsed().as_secs_f64() * 1e3 + output_ms;
+    let missed = total_ms > opts.budgets.deadline_ms;
+    let degraded = skip_b || shrink;
     if missed {
         summary.deadline_missed += 1;
     }
+    let rec = &mut state.record;
+    rec.method_b_skipped += u64::from(skip_b);
+    rec.cloud_shrunk += u64::from(shrink);
+    rec.behind_lidar += u64::from(behind);
+    rec.record(
+        &FrameTimes {
+            ingest: ingest_ms,
+            pose: pose_ms,
+            method_a: method_a_ms,
+            method_b: method_b_ms,
+            output: output_ms,
+            total: total_ms,
+        },
+        &opts.budgets,
+        missed,
+        degraded,
+    );
+    let power_w = opts.power.as_mut().and_then(|p| p.watts());
+    if let Some(w) = power_w {
+        state.power_sum += w;
+        state.power_n += 1;
+        state.power_peak = state.power_peak.max(w);
+    }
+    let t_out = Instant::now();
     if let Some(w) = opts.jsonl.as_mut() {
         let line = OutputLine {
             frame,
@@ -605,17 +729,24 @@ fn emit_frame(
                 pose: pose_ms,
                 method_a: method_a_ms,
                 method_b: method_b_ms,
+                output: output_ms,
                 total: total_ms,
             },
-            deadline_ms: opts.deadline_ms,
+            deadline_ms: opts.budgets.deadline_ms,
             deadline_missed: missed,
-            degraded: false,
-            power_w: None,
+            degraded,
+            power_w,
+            power_source: opts.power.as_ref().map_or("none", |p| p.source()),
             faults: FaultsOut {
                 encoder_errors,
                 compass_rejected,
                 compass_errors,
                 method_b_errors: state.method_b_errors,
+                deadline_missed: rec.missed,
+                degraded_frames: rec.degraded,
+                method_b_skipped: rec.method_b_skipped,
+                cloud_shrunk: rec.cloud_shrunk,
+                behind_lidar: rec.behind_lidar,
                 ..FaultsOut::new(
                     &stream.faults(),
                     summary.invalid_readings,
@@ -626,10 +757,12 @@ fn emit_frame(
                 rpm: f64::from(rev.rpm),
                 packets: rev.packets,
                 valid,
+                backlog_bytes,
             },
         };
         line.write_to(w)?;
     }
+    state.last_output_ms = t_out.elapsed().as_secs_f64() * 1e3;
     *ingest = Duration::ZERO;
     // Output errors end the run, so only this path needs the frame's time.
     state.busy += t_frame.elapsed();

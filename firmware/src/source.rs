@@ -145,6 +145,14 @@ impl LidarSource {
         matches!(self, LidarSource::Capture { .. })
     }
 
+    /// Bytes queued on a serial port, unread (`None` for other sources or a closed port).
+    pub fn backlog_bytes(&self) -> Option<u32> {
+        match self {
+            LidarSource::Serial(link) => link.backlog_bytes(),
+            _ => None,
+        }
+    }
+
     /// Reads what is available into `buf`.
     pub fn read(&mut self, buf: &mut [u8]) -> SourceRead {
         match self {

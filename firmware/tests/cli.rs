@@ -580,3 +580,133 @@ fn replay_of_a_simulated_recording_finds_its_true_objects() {
         "Method B: {b}/{rb} match a true object of their class"
     );
 }
+
+/// The deadline table that a run prints at its end (from `| stage` to the power line).
+fn table_of(stderr: &str) -> String {
+    let start = stderr.find("| stage |").expect("a deadline table");
+    let rest = &stderr[start..];
+    let end = rest.find("power: ").expect("a power line");
+    let tail = &rest[end..];
+    let nl = tail.find('\n').map_or(tail.len(), |i| i + 1);
+    rest[..end + nl].to_owned()
+}
+
+#[test]
+fn run_ends_with_the_deadline_table_and_report_rebuilds_it() {
+    let jsonl = tmp("table.jsonl");
+    let out = umbra(&[
+        "run",
+        "--frames",
+        "120",
+        "--speed",
+        "max",
+        "--quiet",
+        "--jsonl",
+        jsonl.to_str().unwrap(),
+    ]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{stderr}");
+    let table = table_of(&stderr);
+    for stage in ["ingest", "pose", "method_a", "method_b", "output", "total"] {
+        assert!(table.contains(&format!("| {stage} |")), "{table}");
+    }
+    assert!(table.contains("| total | 120 |"), "{table}");
+    assert!(table.contains("power: mean "), "{table}");
+    assert!(table.contains("source: model (Pi 5 figures"), "{table}");
+    // Every line carries the figures the table is made of, and validates.
+    let lines = json_lines(&jsonl);
+    assert_eq!(lines.len(), 120);
+    let s = schema();
+    for l in &lines {
+        assert!(l["timing_ms"]["output"].is_number(), "{l}");
+        assert!(l["power_source"].is_string(), "{l}");
+        if let Some(s) = &s {
+            validate(l, s, "line").unwrap();
+        }
+    }
+    // The model needs half a second of run before its first figure; 120 frames flat out take
+    // longer than that.
+    assert!(lines.last().unwrap()["power_w"].as_f64().unwrap() > 2.8);
+    let rep = umbra(&["report", jsonl.to_str().unwrap()]);
+    assert!(
+        rep.status.success(),
+        "{}",
+        String::from_utf8_lossy(&rep.stderr)
+    );
+    assert_eq!(String::from_utf8(rep.stdout).unwrap(), table);
+}
+
+#[test]
+fn over_budget_frames_shed_method_b_first_and_are_counted() {
+    // A 2 ms deadline: Method B (several ms) cannot fit, so the policy skips it once its time
+    // is known; Method A overruns its share, so the cloud shrinks; frames still miss.
+    let cfg = tmp("tight.toml");
+    std::fs::write(&cfg, "[runtime]\ndeadline_ms = 2.0\n").unwrap();
+    let jsonl = tmp("tight.jsonl");
+    let out = umbra(&[
+        "run",
+        "--frames",
+        "20",
+        "--speed",
+        "max",
+        "--quiet",
+        "--config",
+        cfg.to_str().unwrap(),
+        "--jsonl",
+        jsonl.to_str().unwrap(),
+    ]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{stderr}");
+    let lines = json_lines(&jsonl);
+    let last = &lines.last().unwrap()["faults"];
+    // Frames 0–1 fill the raster; frame 2 runs B and learns its time; 3.. skip it.
+    let with_b = lines
+        .iter()
+        .filter(|l| l["timing_ms"].get("method_b").is_some())
+        .count();
+    assert_eq!(with_b, 1, "Method B ran only until its time was known");
+    assert_eq!(last["method_b_skipped"], 17);
+    assert!(last["cloud_shrunk"].as_u64().unwrap() > 0, "{last}");
+    assert!(lines[3]["degraded"].as_bool().unwrap());
+    let degraded = lines.iter().filter(|l| l["degraded"] == true).count() as u64;
+    assert_eq!(last["degraded_frames"], degraded);
+    let missed = lines
+        .iter()
+        .filter(|l| l["deadline_missed"] == true)
+        .count() as u64;
+    assert_eq!(last["deadline_missed"], missed);
+    let table = table_of(&stderr);
+    assert!(
+        table.contains(&format!(
+            "{missed} missed, {degraded} degraded (Method B skipped 17"
+        )),
+        "{table}"
+    );
+}
+
+#[test]
+fn bad_budgets_and_power_settings_name_the_field() {
+    for (toml, field) in [
+        (
+            "[runtime.budget_ms]\nmethod_b = 300.0\n",
+            "runtime.budget_ms.method_b",
+        ),
+        (
+            "[runtime.budget_ms]\nmethod_a = 200.0\nmethod_b = 200.0\n",
+            "runtime.budget_ms",
+        ),
+        ("[power]\nbudget_w = -1.0\n", "power.budget_w"),
+        ("[power]\nsource = \"solar\"\n", "source"),
+        ("[power]\nsource = \"pmic\"\n", "power.source"),
+    ] {
+        let cfg = tmp("bad-power.toml");
+        std::fs::write(&cfg, toml).unwrap();
+        let out = umbra(&["run", "--frames", "1", "--config", cfg.to_str().unwrap()]);
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{toml}: {stderr}");
+        assert!(stderr.contains(field), "{toml}: {stderr}");
+    }
+    let out = umbra(&["report", "/nonexistent/run.jsonl"]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("/nonexistent/run.jsonl"));
+}

@@ -62,6 +62,9 @@ pub struct DatasetConfig {
     pub recordings: bool,
     /// Pictures of the first N scenarios.
     pub pictures: usize,
+    /// Put every scenario in the test split (a second test set, e.g. of room kinds a model
+    /// was not trained on).
+    pub test_only: bool,
 }
 
 impl Default for DatasetConfig {
@@ -76,6 +79,7 @@ impl Default for DatasetConfig {
             method_a: true,
             recordings: true,
             pictures: 3,
+            test_only: false,
         }
     }
 }
@@ -355,7 +359,11 @@ pub fn generate(
     }
     fs::create_dir_all(out).map_err(|e| io_err(out, e))?;
     let start = Instant::now();
-    let split_of = splits(cfg.scenarios, cfg.seed);
+    let split_of = if cfg.test_only {
+        vec![Split::Test; cfg.scenarios]
+    } else {
+        splits(cfg.scenarios, cfg.seed)
+    };
     let results: Vec<Result<ScenarioResult, String>> = (0..cfg.scenarios)
         .into_par_iter()
         .map(|i| scenario_to_disk(i, split_of[i], cfg, out, &progress))

@@ -74,3 +74,9 @@ pub fn counted(f: impl FnOnce()) -> u64 {
     WATCH.with(|w| w.set(false));
     COUNT.with(|c| c.get())
 }
+
+/// The allocations counted so far inside the innermost running [`counted`] (for marking
+/// points inside a long call, e.g. at every frame of a run).
+pub fn allocations() -> u64 {
+    COUNT.with(|c| c.get())
+}

@@ -1,6 +1,6 @@
 //! `umbra-sim`: the simulator's command line.
 //!
-//! * `umbra-sim dataset --out DIR [--scenarios 50] [--frames 200] [--seed 1] [--kinds rect,lshape,tworooms]`
+//! * `umbra-sim dataset --out DIR [--scenarios 50] [--frames 200] [--seed 1] [--kinds rect,lshape,tworooms] [--clutter 3] [--test-only]`
 //!   writes the datasets of `sim::dataset` with a progress bar.
 //! * `umbra-sim speed [--scenarios 16] [--frames 200]` measures labelled frames per second
 //!   with rasters and labels built in memory.
@@ -71,6 +71,9 @@ enum Command {
         /// Pictures of the first N scenarios.
         #[arg(long, default_value_t = 3)]
         pictures: usize,
+        /// Every scenario in the test split (a second test set from other room kinds).
+        #[arg(long)]
+        test_only: bool,
     },
     /// Labelled frames per second, rasters and labels in memory.
     Speed {
@@ -164,6 +167,7 @@ fn run(command: Command) -> Result<(), String> {
             no_method_a,
             no_recordings,
             pictures,
+            test_only,
         } => {
             let cfg = DatasetConfig {
                 scenarios,
@@ -178,6 +182,7 @@ fn run(command: Command) -> Result<(), String> {
                 method_a: !no_method_a,
                 recordings: !no_recordings,
                 pictures,
+                test_only,
                 ..DatasetConfig::default()
             };
             let bar = ProgressBar::new((scenarios * frames) as u64);

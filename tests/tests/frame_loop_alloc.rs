@@ -1,0 +1,104 @@
+//! The whole frame loop (`firmware::runner::run`: ingest → pose → Method A → Method B → JSON
+//! line, deadline histograms, overrun policy, power model) allocates nothing per frame after
+//! warm-up, outside tract; with Method B on, the per-frame count is tract's constant. A counting
+//! global allocator watches the loop's thread; the JSON sink marks the count at every line.
+
+use std::io::Write;
+use std::sync::Arc;
+use std::sync::atomic::AtomicBool;
+
+use firmware::config::Config;
+use firmware::odom::PoseState;
+use firmware::power::PowerMeter;
+use firmware::runner::{self, MethodBSetup, PoseInput, RunOptions, SecondsClock};
+use firmware::source::{LidarSource, Pacing};
+use umbra_tests::{allocations, counted};
+
+#[global_allocator]
+static ALLOC: umbra_tests::Counting = umbra_tests::Counting;
+
+/// A JSON Lines sink that notes the allocation count at every line, in a buffer sized before.
+struct Marks(Arc<std::sync::Mutex<Vec<u64>>>);
+
+impl Write for Marks {
+    fn write(&mut self, b: &[u8]) -> std::io::Result<usize> {
+        if b.contains(&b'\n') {
+            let mut m = self.0.lock().unwrap();
+            assert!(m.len() < m.capacity(), "marks buffer too small");
+            m.push(allocations());
+        }
+        Ok(b.len())
+    }
+    fn flush(&mut self) -> std::io::Result<()> {
+        Ok(())
+    }
+}
+
+const FRAMES: u64 = 40;
+const WARM_UP: usize = 5;
+
+fn per_frame(method_b: bool) -> Vec<u64> {
+    let cfg = Config::default();
+    let mut source = LidarSource::sim(3, 3);
+    let cal = source.sim_calibration();
+    let marks = Arc::new(std::sync::Mutex::new(Vec::with_capacity(
+        FRAMES as usize + 8,
+    )));
+    let b = method_b.then(|| MethodBSetup {
+        model: models::yolo::YoloModel::builtin(Default::default()).expect("model"),
+        raster: cfg.method_b_raster(),
+        decode: cfg.method_b_decode(),
+        mount: cfg.lidar_mount(),
+    });
+    let opts = RunOptions {
+        frames: Some(FRAMES),
+        seconds: None,
+        seconds_clock: SecondsClock::Wall,
+        pacing: Pacing::Max,
+        budgets: cfg.budgets(),
+        power: Some(PowerMeter::model(&cfg.power, None)),
+        power_budget_w: cfg.power.budget_w,
+        jsonl: Some(Box::new(Marks(marks.clone()))),
+        stats: Some(Box::new(std::io::sink())),
+        stop: Arc::new(AtomicBool::new(false)),
+        pose: Some(PoseInput {
+            state: PoseState::new(cfg.pose_filter(cal), cal.is_some()),
+            file: None,
+            queue: Default::default(),
+            opencr: None,
+            compass: None,
+            compass_errors: 0,
+        }),
+        method_a: Some((cfg.method_a(), cfg.lidar_mount())),
+        method_b: b,
+    };
+    let mut summary = None;
+    counted(|| summary = Some(runner::run(&mut source, cfg.lds01(), opts).expect("run")));
+    let summary = summary.unwrap();
+    assert_eq!(summary.frames, FRAMES);
+    let m = marks.lock().unwrap().clone();
+    assert_eq!(m.len() as u64, FRAMES);
+    m.windows(2).map(|w| w[1] - w[0]).collect()
+}
+
+#[test]
+fn frames_allocate_nothing_after_warm_up() {
+    let d = per_frame(false);
+    println!("allocations per frame, Method A only: {d:?}");
+    assert!(
+        d[WARM_UP..].iter().all(|&n| n == 0),
+        "frames after warm-up allocated: {d:?}"
+    );
+}
+
+#[test]
+fn with_method_b_only_tract_allocates_and_a_constant_amount() {
+    let d = per_frame(true);
+    println!("allocations per frame, Methods A and B: {d:?}");
+    let steady = &d[WARM_UP..];
+    assert!(
+        steady.iter().all(|&n| n == steady[0]),
+        "per-frame count not constant: {d:?}"
+    );
+    assert!(steady[0] > 0, "tract allocates per run");
+}

@@ -1,0 +1,251 @@
+"""Make umbra's production YOLOv8n in one command: data -> training -> export -> evaluation -> card.
+
+    python training/make_model.py --work /tmp/umbra-model            # all stages
+    python training/make_model.py --work DIR --stages export,eval,card # later stages only
+
+Stages (each prints its progress; everything is seeded and deterministic on CPU):
+  data    `umbra-sim dataset` (built here with cargo, release): the training set (rooms of the
+          kinds in --kinds, scenario-level train/val/test split), a second test set of a room
+          kind not in training with more clutter (--ood-kinds, --ood-clutter, all test), and
+          the fixed reference split that `tests/tests/eval_b_ultralytics.rs` regenerates.
+  train   YOLOv8n from scratch (or from --init weights) with `train.py`: rect 64x384, every
+          Ultralytics augmentation off, the mirrored room on (`mirror.py`).
+  export  fp32 ONNX and the int8 QOperator form (`export.py`) into models/yolo, and the
+          checkpoint itself (models/yolo/umbra-yolov8n.pt, to continue from in a later run).
+  eval    the Rust evaluator (`umbra-lab eval-b`) on both test sets, fp32 and int8, and
+          Ultralytics' validator (`ultra_val.py`) on both; writes models/yolo/ultralytics-test.json
+          for the Rust test.
+  card    the generated part of models/README.md (data, seed, epochs, hardware, time, metrics
+          per class, sha256 of every file).
+"""
+
+import argparse
+import hashlib
+import json
+import os
+import platform
+import shutil
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+HERE = Path(__file__).resolve().parent
+ROOT = HERE.parent
+MODELS = ROOT / "models" / "yolo"
+CARD = ROOT / "models" / "README.md"
+BEGIN, END = "<!-- model-card:begin -->", "<!-- model-card:end -->"
+# The split `tests/tests/eval_b_ultralytics.rs` regenerates and compares against.
+REFERENCE = ["--scenarios", "40", "--frames", "50", "--seed", "11"]
+STAGES = ["data", "train", "export", "eval", "card"]
+
+
+def sh(cmd: list[str], **kw) -> None:
+    print("+", " ".join(str(c) for c in cmd), flush=True)
+    subprocess.run([str(c) for c in cmd], check=True, **kw)
+
+
+def sha256(p: Path) -> str:
+    return hashlib.sha256(p.read_bytes()).hexdigest()
+
+
+def bins() -> tuple[Path, Path]:
+    sh(["cargo", "build", "--release", "-p", "umbra-sim", "--bin", "umbra-sim", "-p",
+        "umbra-firmware", "--bin", "umbra-lab"], cwd=ROOT)
+    target = Path(os.environ.get("CARGO_TARGET_DIR", ROOT / "target")) / "release"
+    return target / "umbra-sim", target / "umbra-lab"
+
+
+def dataset(sim: Path, out: Path, args: list[str]) -> dict:
+    """Writes a dataset unless `out` already holds one made by the same arguments."""
+    stamp = out / "command.txt"
+    want = " ".join(args)
+    if stamp.exists() and stamp.read_text() == want:
+        print(f"dataset {out} is up to date ({want})")
+    else:
+        if out.exists():
+            shutil.rmtree(out)
+        sh([sim, "dataset", "--out", out, "--no-method-a", "--no-recordings", "--pictures", "0",
+            *args])
+        stamp.write_text(want)
+    return json.loads((out / "dataset.json").read_text())
+
+
+def sets(a) -> dict[str, list[str]]:
+    common = ["--frames", str(a.frames)]
+    return {
+        "train": ["--scenarios", str(a.scenarios), *common, "--seed", str(a.seed), "--kinds",
+                  a.kinds, "--clutter", str(a.clutter)],
+        "ood": ["--scenarios", str(a.ood_scenarios), *common, "--seed", str(a.seed + 1),
+                "--kinds", a.ood_kinds, "--clutter", str(a.ood_clutter), "--test-only"],
+        "reference": REFERENCE,
+    }
+
+
+def evaluate(lab: Path, sim_sets: dict, work: Path, threads: int) -> dict:
+    res = {}
+    for model in ("umbra-yolov8n.onnx", "umbra-yolov8n-int8.onnx"):
+        for name in ("train", "ood"):
+            out = work / f"eval-{name}-{model}.json"
+            sh([lab, "eval-b", "--data", work / name, "--split", "test", "--model",
+                MODELS / model, "--threads", str(threads), "--json", out])
+            res[f"{name}/{model}"] = json.loads(out.read_text())
+    py = sys.executable
+    for name in ("train", "ood", "reference"):
+        out = work / f"ultra-{name}.json"
+        sh([py, HERE / "ultra_val.py", "--weights", MODELS / "umbra-yolov8n.pt", "--data",
+            work / name / "data.yaml", "--split", "test", "--json", out])
+        res[f"ultralytics/{name}"] = json.loads(out.read_text())
+    ref = res["ultralytics/reference"]
+    ref = {
+        "what": "Ultralytics validation (training/ultra_val.py: DetectionValidator, 64x384 "
+                "unpadded) of the checkpoint exported to models/yolo/umbra-yolov8n.onnx",
+        "dataset": {"command": "umbra-sim dataset " + " ".join(REFERENCE), "split": "test",
+                    "images": ref.get("images")},
+        "weights_sha256": sha256(MODELS / "umbra-yolov8n.pt"),
+        **{k: v for k, v in ref.items() if k != "images"},
+    }
+    (MODELS / "ultralytics-test.json").write_text(json.dumps(ref, indent=2) + "\n")
+    (work / "eval.json").write_text(json.dumps(res, indent=2))
+    return res
+
+
+def hardware(device: str) -> str:
+    cpu = platform.processor() or platform.machine()
+    try:
+        for line in Path("/proc/cpuinfo").read_text().splitlines():
+            if line.startswith("model name"):
+                cpu = line.split(":", 1)[1].strip()
+                break
+    except OSError:
+        pass
+    if device != "cpu":
+        import torch
+
+        return f"{torch.cuda.get_device_name(0)} (CUDA), host CPU {cpu}"
+    return f"CPU only: {os.cpu_count()} x {cpu}"
+
+
+def table(m: dict) -> list[str]:
+    rows = ["| class | P | R | mAP50 | mAP50-95 |", "|---|---|---|---|---|",
+            f"| all | {m['p']:.3f} | {m['r']:.3f} | {m['map50']:.3f} | {m['map50_95']:.3f} |"]
+    for c in m["per_class"]:
+        rows.append(f"| {c['class']} | {c['p']:.3f} | {c['r']:.3f} | {c['map50']:.3f} | "
+                    f"{c['map50_95']:.3f} |")
+    return rows
+
+
+def card(a, work: Path, info: dict) -> None:
+    ev = json.loads((work / "eval.json").read_text())
+    ds = {k: json.loads((work / k / "dataset.json").read_text()) for k in ("train", "ood")}
+    cmd = info["command"]
+    t = ds["train"]["frames"]
+    L = [BEGIN, "", "### Model card (generated by `training/make_model.py`)", "",
+         f"- **Command:** `{cmd}`" + (f" (stages run as: {'; '.join(info['runs'])})"
+                                      if len(info["runs"]) > 1 else ""),
+         "- **Architecture:** YOLOv8n (`training/yolov8n-umbra.yaml`, nc 4: chair, box, desk, "
+         "door_frame), " + (f"initialised from `{info['init']}`" if info.get("init")
+                            else "from scratch (no pretrained weights)") + ".",
+         f"- **Training data:** `umbra-sim dataset {' '.join(sets(a)['train'])}` "
+         f"({t['train']:,} train / {t['val']:,} val / {t['test']:,} test images; scenarios "
+         "split by a seeded shuffle, so no test scenario is seen in training).",
+         f"- **Second test set (room kinds not in training):** `umbra-sim dataset "
+         f"{' '.join(sets(a)['ood'])}` ({ds['ood']['frames']['test']:,} images).",
+         f"- **Training:** {info['epochs']} epochs, batch {a.batch}, seed {a.seed}, mirrored "
+         f"room p = {a.mirror}, every Ultralytics augmentation off; Ultralytics "
+         f"{info['ultralytics']}, torch {info['torch']}; {info['hardware']}; "
+         f"{info['train_s']:,.0f} s of training. Checkpoint: `best.pt` (highest val fitness).",
+         "- **Export:** fp32 ONNX opset 17, simplified; int8 QOperator, convolutions only, "
+         "per-tensor, calibrated on the first 256 training images (`training/export.py`).",
+         "", "**Held-out test scenarios** (Rust evaluator `umbra-lab eval-b`, fp32):", ""]
+    L += table(ev["train/umbra-yolov8n.onnx"])
+    L += ["", "**Second test set, unseen room kind** (fp32):", ""]
+    L += table(ev["ood/umbra-yolov8n.onnx"])
+    L += ["", "| set | model | mAP50 | mAP50-95 | Ultralytics mAP50 / mAP50-95 (fp32 .pt) |",
+          "|---|---|---|---|---|"]
+    for name, label in (("train", "held-out"), ("ood", "unseen kind")):
+        u = ev[f"ultralytics/{name}"]
+        for model in ("umbra-yolov8n.onnx", "umbra-yolov8n-int8.onnx"):
+            m = ev[f"{name}/{model}"]
+            L.append(f"| {label} | {model} | {m['map50']:.4f} | {m['map50_95']:.4f} | "
+                     f"{u['map50']:.4f} / {u['map50_95']:.4f} |")
+    L += ["", "**sha256:**", ""]
+    for f in ("umbra-yolov8n.pt", "umbra-yolov8n.onnx", "umbra-yolov8n-int8.onnx",
+              "ultralytics-test.json"):
+        L.append(f"- `{f}` {sha256(MODELS / f)}")
+    L += ["", END]
+    text = CARD.read_text()
+    if BEGIN in text:
+        text = text[: text.index(BEGIN)] + "\n".join(L) + text[text.index(END) + len(END):]
+    else:
+        text = text.rstrip() + "\n\n" + "\n".join(L) + "\n"
+    CARD.write_text(text)
+    print(f"wrote the model card in {CARD}")
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--work", type=Path, required=True, help="datasets, runs' results, evals")
+    ap.add_argument("--stages", default=",".join(STAGES), help=",".join(STAGES))
+    ap.add_argument("--scenarios", type=int, default=600)
+    ap.add_argument("--frames", type=int, default=25)
+    ap.add_argument("--seed", type=int, default=21)
+    ap.add_argument("--kinds", default="rect,tworooms")
+    ap.add_argument("--clutter", type=int, default=3)
+    ap.add_argument("--ood-scenarios", type=int, default=40)
+    ap.add_argument("--ood-kinds", default="lshape")
+    ap.add_argument("--ood-clutter", type=int, default=6)
+    ap.add_argument("--epochs", type=int, default=24)
+    ap.add_argument("--batch", type=int, default=32)
+    ap.add_argument("--mirror", type=float, default=0.5)
+    ap.add_argument("--device", default="cpu")
+    ap.add_argument("--workers", type=int, default=2)
+    ap.add_argument("--init", type=Path, help="start from these weights instead of scratch")
+    ap.add_argument("--resume", action="store_true", help="continue an interrupted run")
+    ap.add_argument("--threads", type=int, default=1, help="tract threads for eval")
+    a = ap.parse_args()
+    stages = a.stages.split(",")
+    unknown = set(stages) - set(STAGES)
+    if unknown:
+        ap.error(f"unknown stages {sorted(unknown)}")
+    work = a.work.resolve()
+    work.mkdir(parents=True, exist_ok=True)
+    info_path = work / "info.json"
+    info = json.loads(info_path.read_text()) if info_path.exists() else {"runs": []}
+    info["command"] = ("python training/make_model.py --work DIR "
+                       + " ".join(f"--{k.replace('_', '-')} {v}" for k, v in vars(a).items()
+                                  if k not in ("work", "stages", "resume", "threads")
+                                  and v is not None))
+    info["runs"].append(" ".join(sys.argv[1:]))
+    sim, lab = bins()
+    if "data" in stages:
+        for name, args in sets(a).items():
+            dataset(sim, work / name, args)
+    if "train" in stages:
+        import offline  # noqa: F401
+        import torch
+        import ultralytics
+        from train import train
+
+        t0 = time.time()
+        w = train(work / "train" / "data.yaml", a.epochs, a.batch, a.seed, a.device, a.workers,
+                  "production", a.resume, a.mirror, a.init)
+        info.update(train_s=info.get("train_s", 0) * a.resume + time.time() - t0,
+                    epochs=a.epochs, weights=str(w), init=str(a.init) if a.init else None,
+                    ultralytics=ultralytics.__version__, torch=torch.__version__,
+                    hardware=hardware(a.device))
+        info_path.write_text(json.dumps(info, indent=2))
+    if "export" in stages:
+        best = Path(info["weights"]) / "best.pt"
+        sh([sys.executable, HERE / "export.py", "--weights", best, "--out", MODELS, "--calib",
+            work / "train" / "images" / "train", "--calib-images", "256"])
+        shutil.copy(best, MODELS / "umbra-yolov8n.pt")
+    if "eval" in stages:
+        evaluate(lab, sets(a), work, a.threads)
+    if "card" in stages:
+        card(a, work, info)
+    info_path.write_text(json.dumps(info, indent=2))
+
+
+if __name__ == "__main__":
+    main()
