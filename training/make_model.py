@@ -217,7 +217,7 @@ def main() -> None:
                                   if k not in ("work", "stages", "resume", "threads")
                                   and v is not None))
     info["runs"].append(" ".join(sys.argv[1:]))
-    sim, lab = bins()
+    sim, lab = bins() if {"data", "eval"} & set(stages) else (None, None)
     if "data" in stages:
         for name, args in sets(a).items():
             dataset(sim, work / name, args)

@@ -112,6 +112,15 @@ pub struct Common {
     /// No per-frame statistics lines.
     #[arg(long, short)]
     pub quiet: bool,
+    /// Record the run to this MCAP file (Foxglove schemas: scan, transforms, pose, scene).
+    #[arg(long, value_name = "PATH.mcap")]
+    pub record: Option<PathBuf>,
+    /// Serve the same channels live over Foxglove's WebSocket protocol, e.g. 0.0.0.0:8765.
+    #[arg(long, value_name = "HOST:PORT")]
+    pub live: Option<std::net::SocketAddr>,
+    /// When the run ends, draw the map, robot, walls, doors and objects to this SVG file.
+    #[arg(long, value_name = "PATH.svg")]
+    pub snapshot: Option<PathBuf>,
 }
 
 /// `umbra run`.

@@ -16,6 +16,8 @@
 //! | [`confusion_png`] | the evaluation's confusion matrix as a PNG              |
 //! | [`deadline`] | stage histograms, budgets, the overrun policy, the deadline table |
 //! | [`power`]    | watts from an INA219, the Pi 5 PMIC or a CPU-time model; the budget |
+//! | [`snapshot`] | `--snapshot PATH.svg`: the map, robot, walls, doors and objects as a picture |
+//! | `viz`        | `--record` MCAP and `--live` Foxglove WebSocket (feature `viz`) |
 //! | [`report`]   | `umbra report OUT.jsonl`: the deadline and power table of a run |
 #![deny(unsafe_code, missing_docs)]
 
@@ -32,4 +34,7 @@ pub mod output;
 pub mod power;
 pub mod report;
 pub mod runner;
+pub mod snapshot;
 pub mod source;
+#[cfg(feature = "viz")]
+pub mod viz;

@@ -336,6 +336,10 @@ fn run_loop(
     let method_b = load_method_b(cfg, common)?;
     let power = PowerMeter::start(&cfg.power).map_err(|e| (EXIT_USAGE, e))?;
     log::info!("power: {}", power.source());
+    let viz = start_viz(common)?;
+    if let Some(p) = &common.snapshot {
+        firmware::snapshot::check_path(p).map_err(|m| (EXIT_USAGE, format!("--snapshot {m}")))?;
+    }
     let opts = RunOptions {
         frames: common.frames,
         seconds: common.seconds,
@@ -353,11 +357,50 @@ fn run_loop(
             .enabled
             .then(|| (cfg.method_a(), cfg.lidar_mount())),
         method_b,
+        viz,
+        snapshot: common.snapshot.clone(),
     };
     let summary = runner::run(source, cfg.lds01(), opts)
         .map_err(|e| (EXIT_FAULT, format!("cannot write output: {e}")))?;
     print_summary(&summary);
     Ok(())
+}
+
+/// Opens the MCAP file and/or the live server (`--record`, `--live`).
+#[cfg(feature = "viz")]
+fn start_viz(common: &Common) -> Result<Option<runner::VizLink>, Failure> {
+    if common.record.is_none() && common.live.is_none() {
+        return Ok(None);
+    }
+    if let Some(p) = &common.record {
+        firmware::snapshot::check_path(p).map_err(|m| (EXIT_USAGE, format!("--record {m}")))?;
+    }
+    let targets = firmware::viz::VizTargets {
+        record: common.record.clone(),
+        live: common.live,
+    };
+    let link = runner::VizLink::start(&targets).map_err(|m| (EXIT_USAGE, m))?;
+    if let Some(port) = link.live_port() {
+        log::info!(
+            "live view: Foxglove WebSocket on port {port} (open ws://<this host>:{port} in Foxglove)"
+        );
+    }
+    if let Some(p) = &common.record {
+        log::info!("recording to {}", p.display());
+    }
+    Ok(Some(link))
+}
+
+/// Built without the `viz` feature: `--record` and `--live` are errors.
+#[cfg(not(feature = "viz"))]
+fn start_viz(common: &Common) -> Result<Option<runner::VizLink>, Failure> {
+    if common.record.is_some() || common.live.is_some() {
+        return Err((
+            EXIT_USAGE,
+            "--record/--live: this umbra was built without the viz feature".into(),
+        ));
+    }
+    Ok(None)
 }
 
 /// Built without Method B: says so once and runs Method A only.
@@ -415,5 +458,11 @@ fn print_summary(s: &Summary) {
         s.link.1,
         s.deadline_missed
     );
+    if s.viz_dropped > 0 {
+        eprintln!(
+            "umbra: recording/live view dropped {} frames (its thread was behind)",
+            s.viz_dropped
+        );
+    }
     eprint!("{}", s.table());
 }

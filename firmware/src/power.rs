@@ -10,7 +10,7 @@
 //!    CPU time is scaled by how much slower the modelled board is ([`Board::slowdown`]).
 //!
 //! The frame loop only reads the latest figure ([`PowerMeter::watts`]): no allocation, no I/O
-//! on the frame's path except the model's read of `/proc/self/stat` into a stack buffer twice a
+//! on the frame's path except the model's read of `/proc/self/stat` into a stack buffer (once
 //! every [`SAMPLE_PERIOD`]).
 
 use std::io::Read as _;

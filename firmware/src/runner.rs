@@ -45,6 +45,43 @@ impl YoloModel {
 
 use drivers::opencr::OpencrReader;
 
+#[cfg(feature = "viz")]
+pub use crate::viz::VizLink;
+
+/// Built without recording and live view (`viz` feature off): no link can exist.
+#[cfg(not(feature = "viz"))]
+#[derive(Debug)]
+pub enum VizLink {}
+
+#[cfg(not(feature = "viz"))]
+impl VizLink {
+    fn send(&mut self, _fill: impl FnOnce(&mut VizFrameStub)) {
+        match *self {}
+    }
+    fn dropped(&self) -> u64 {
+        match *self {}
+    }
+    fn finish(self) -> Result<(), String> {
+        match self {}
+    }
+}
+
+/// What a frame would carry to the viz thread (stub of `viz::VizFrame`).
+#[cfg(not(feature = "viz"))]
+struct VizFrameStub {
+    frame: u64,
+    t: f64,
+    pose: Pose2,
+    mount: Pose2,
+    ranges: [f32; SCAN_COLUMNS],
+    objects: heapless::Vec<ObjectOut, 1>,
+    walls: heapless::Vec<WallOut, 1>,
+    doors: heapless::Vec<DoorOut, 1>,
+}
+
+#[cfg(feature = "viz")]
+use crate::viz::VizFrame as VizFrameStub;
+
 use crate::odom::{OdomFile, OdomRecord, PoseState};
 
 use crate::deadline::{
@@ -96,6 +133,10 @@ pub struct RunOptions {
     pub method_a: Option<(MethodAConfig, Pose2)>,
     /// Method B's model and settings; `None`: Method B off.
     pub method_b: Option<MethodBSetup>,
+    /// Recording / live view (`--record`, `--live`).
+    pub viz: Option<VizLink>,
+    /// Where to draw the last frame when the run ends (`--snapshot`).
+    pub snapshot: Option<std::path::PathBuf>,
 }
 
 /// Method B at run time: the loaded model and how to read its boxes.
@@ -139,6 +180,8 @@ struct FrameState {
     record: DeadlineRecord,
     /// Time it took to write the previous frame's line, ms.
     last_output_ms: f64,
+    /// The pose of the last frame.
+    last_pose: Pose2,
     /// Sum, count and peak of the power figures.
     power_sum: f64,
     power_n: u64,
@@ -265,6 +308,8 @@ pub struct Summary {
     pub budgets: Option<Budgets>,
     /// The power verdict.
     pub power: PowerVerdict,
+    /// Frames the recording / live view dropped (its thread was behind).
+    pub viz_dropped: u64,
 }
 
 impl Summary {
@@ -306,6 +351,7 @@ pub fn run(
         policy: Policy::default(),
         record: DeadlineRecord::default(),
         last_output_ms: 0.0,
+        last_pose: Pose2::IDENTITY,
         power_sum: 0.0,
         power_n: 0,
         power_peak: 0.0,
@@ -409,6 +455,34 @@ pub fn run(
     summary.sensor_seconds = stream.sensor_time_s();
     summary.wall_seconds = start.elapsed().as_secs_f64();
     summary.stop_reason = reason;
+    if let Some(path) = opts.snapshot.as_deref() {
+        let cloud: Vec<Point2> = state.method_a.cloud().iter().copied().collect();
+        let caption = format!(
+            "umbra, frame {}, t {:.1} s: {} objects, {} walls, {} doors",
+            summary.frames.saturating_sub(1),
+            summary.sensor_seconds,
+            state.objects.len(),
+            state.walls.len(),
+            state.doors.len()
+        );
+        let scene = crate::snapshot::Scene {
+            cloud: &cloud,
+            robot: state.last_pose,
+            walls: &state.walls,
+            doors: &state.doors,
+            objects: &state.objects,
+            caption: &caption,
+        };
+        if let Err(e) = crate::snapshot::write(path, &scene) {
+            log::error!("{e}");
+        }
+    }
+    if let Some(v) = opts.viz.take() {
+        summary.viz_dropped = v.dropped();
+        if let Err(e) = v.finish() {
+            log::error!("{e}");
+        }
+    }
     summary.deadlines = state.record.clone();
     summary.budgets = Some(opts.budgets);
     summary.power = PowerVerdict {
@@ -763,6 +837,34 @@ fn emit_frame(
         line.write_to(w)?;
     }
     state.last_output_ms = t_out.elapsed().as_secs_f64() * 1e3;
+    state.last_pose = pose;
+    let mount = match (&opts.method_a, &opts.method_b) {
+        (Some((_, m)), _) => *m,
+        (None, Some(b)) => b.mount,
+        (None, None) => Pose2::IDENTITY,
+    };
+    if let Some(v) = opts.viz.as_mut() {
+        let st = &*state;
+        v.send(|f: &mut VizFrameStub| {
+            f.frame = frame;
+            f.t = t;
+            f.pose = pose;
+            f.mount = mount;
+            f.ranges.copy_from_slice(&st.history[slot]);
+            f.objects.clear();
+            f.walls.clear();
+            f.doors.clear();
+            for o in &st.objects {
+                let _ = f.objects.push(o.clone());
+            }
+            for w in &st.walls {
+                let _ = f.walls.push(w.clone());
+            }
+            for d in &st.doors {
+                let _ = f.doors.push(d.clone());
+            }
+        });
+    }
     *ingest = Duration::ZERO;
     // Output errors end the run, so only this path needs the frame's time.
     state.busy += t_frame.elapsed();

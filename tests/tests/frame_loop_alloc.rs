@@ -38,6 +38,10 @@ const FRAMES: u64 = 40;
 const WARM_UP: usize = 5;
 
 fn per_frame(method_b: bool) -> Vec<u64> {
+    per_frame_with(method_b, None)
+}
+
+fn per_frame_with(method_b: bool, viz: Option<runner::VizLink>) -> Vec<u64> {
     let cfg = Config::default();
     let mut source = LidarSource::sim(3, 3);
     let cal = source.sim_calibration();
@@ -71,6 +75,8 @@ fn per_frame(method_b: bool) -> Vec<u64> {
         }),
         method_a: Some((cfg.method_a(), cfg.lidar_mount())),
         method_b: b,
+        viz,
+        snapshot: None,
     };
     let mut summary = None;
     counted(|| summary = Some(runner::run(&mut source, cfg.lds01(), opts).expect("run")));
@@ -101,4 +107,27 @@ fn with_method_b_only_tract_allocates_and_a_constant_amount() {
         "per-frame count not constant: {d:?}"
     );
     assert!(steady[0] > 0, "tract allocates per run");
+}
+
+#[test]
+fn recording_costs_the_loop_no_allocation() {
+    // The viz thread converts and writes (and allocates) on its own; the loop only fills
+    // pooled frames.
+    let path = std::env::temp_dir().join(format!("umbra-alloc-{}.mcap", std::process::id()));
+    let link = runner::VizLink::start(&firmware::viz::VizTargets {
+        record: Some(path.clone()),
+        live: None,
+    })
+    .expect("recorder");
+    let d = per_frame_with(false, Some(link));
+    println!("allocations per frame, Method A, recording: {d:?}");
+    assert!(
+        d[WARM_UP..].iter().all(|&n| n == 0),
+        "frames after warm-up allocated: {d:?}"
+    );
+    assert!(
+        std::fs::metadata(&path).unwrap().len() > 10_000,
+        "frames were recorded"
+    );
+    std::fs::remove_file(&path).ok();
 }

@@ -114,6 +114,21 @@ fn buffers_in_code() -> Vec<(&'static str, usize, usize)> {
             size_of::<f32>(),
         ),
         (
+            "firmware::deadline::BUCKETS",
+            firmware::deadline::BUCKETS,
+            size_of::<u32>(),
+        ),
+        (
+            "size_of::<firmware::deadline::DeadlineRecord>()",
+            1,
+            size_of::<firmware::deadline::DeadlineRecord>(),
+        ),
+        (
+            "firmware::viz::VIZ_POOL",
+            firmware::viz::VIZ_POOL,
+            size_of::<firmware::viz::VizFrame>(),
+        ),
+        (
             "size_of::<perception::yolo::DecodeScratch>()",
             1,
             size_of::<perception::yolo::DecodeScratch>(),

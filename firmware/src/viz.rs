@@ -1,0 +1,398 @@
+//! Recording and live view: the frame loop's results as Foxglove's well-known schemas, written
+//! to an MCAP file (`--record PATH`) and/or served over Foxglove's WebSocket protocol
+//! (`--live HOST:PORT`), through the Foxglove SDK (`foxglove` crate).
+//!
+//! Channels (one [`foxglove::Context`] a run):
+//! * `/scan` `foxglove.LaserScan` in frame `lidar`: the revolution's 360 bins (no return = NaN);
+//! * `/tf` `foxglove.FrameTransforms`: `map → base_link` (the pose at the first ray) and
+//!   `base_link → lidar` (the mount);
+//! * `/pose` `foxglove.PoseInFrame` in `map`;
+//! * `/perception` `foxglove.SceneUpdate` in `map`: objects (a cube coloured by class and a
+//!   label `class score source`), walls (a line list), doors (a thin cube).
+//!
+//! The frame loop never allocates for this: it fills a [`VizFrame`] taken from a pool of
+//! boxes made at start-up and hands it to the viz thread through a bounded channel; the thread
+//! converts, logs and returns the box. When the thread falls behind, frames are dropped and
+//! counted ([`VizLink::dropped`]), never queued without bound.
+
+use std::net::SocketAddr;
+use std::path::PathBuf;
+use std::sync::Arc;
+use std::sync::mpsc::{Receiver, SyncSender, TrySendError, sync_channel};
+use std::thread::JoinHandle;
+
+use foxglove::schemas::{
+    Color, CubePrimitive, FrameTransform, FrameTransforms, LaserScan, LinePrimitive, Point3, Pose,
+    PoseInFrame, Quaternion, SceneEntity, SceneUpdate, TextPrimitive, Timestamp, Vector3,
+    line_primitive,
+};
+use foxglove::{Channel, ChannelBuilder, Context};
+use perception::geometry::Pose2;
+use perception::raster::SCAN_COLUMNS;
+
+use crate::output::{DoorOut, ObjectOut, WallOut};
+
+/// Objects a frame carries to the viz thread.
+pub const VIZ_OBJECTS: usize = 64;
+/// Walls a frame carries.
+pub const VIZ_WALLS: usize = perception::walls::MAX_SEGMENTS;
+/// Doors a frame carries.
+pub const VIZ_DOORS: usize = perception::doors::MAX_DOORS;
+/// Frames in flight between the loop and the viz thread (the pool's size).
+pub const VIZ_POOL: usize = 4;
+
+/// One frame's results, copied out of the loop's buffers.
+#[derive(Debug, Clone)]
+pub struct VizFrame {
+    /// Frame number.
+    pub frame: u64,
+    /// Sensor-clock time of the first ray, s.
+    pub t: f64,
+    /// Robot pose in the map at the first ray.
+    pub pose: Pose2,
+    /// The LiDAR's pose on the robot.
+    pub mount: Pose2,
+    /// Ranges by 1° bin, m (0 = no return).
+    pub ranges: [f32; SCAN_COLUMNS],
+    /// Objects.
+    pub objects: heapless::Vec<ObjectOut, VIZ_OBJECTS>,
+    /// Walls.
+    pub walls: heapless::Vec<WallOut, VIZ_WALLS>,
+    /// Doors.
+    pub doors: heapless::Vec<DoorOut, VIZ_DOORS>,
+}
+
+impl Default for VizFrame {
+    fn default() -> Self {
+        VizFrame {
+            frame: 0,
+            t: 0.0,
+            pose: Pose2::IDENTITY,
+            mount: Pose2::IDENTITY,
+            ranges: [0.0; SCAN_COLUMNS],
+            objects: heapless::Vec::new(),
+            walls: heapless::Vec::new(),
+            doors: heapless::Vec::new(),
+        }
+    }
+}
+
+/// Where the viz thread sends frames.
+#[derive(Debug, Clone, Default)]
+pub struct VizTargets {
+    /// MCAP file to write.
+    pub record: Option<PathBuf>,
+    /// Address to serve the live view on.
+    pub live: Option<SocketAddr>,
+}
+
+/// The loop's end of the viz thread.
+pub struct VizLink {
+    to_thread: Option<SyncSender<Box<VizFrame>>>,
+    pool: Receiver<Box<VizFrame>>,
+    thread: Option<JoinHandle<Result<(), String>>>,
+    dropped: u64,
+    sent: u64,
+    live_port: Option<u16>,
+}
+
+impl std::fmt::Debug for VizLink {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("VizLink")
+            .field("sent", &self.sent)
+            .field("dropped", &self.dropped)
+            .finish()
+    }
+}
+
+impl VizLink {
+    /// Opens the MCAP file and/or starts the live server, and the thread that feeds them.
+    /// Errors name the file or address.
+    pub fn start(targets: &VizTargets) -> Result<VizLink, String> {
+        let ctx = Context::new();
+        let mcap = match &targets.record {
+            Some(path) => Some(
+                foxglove::McapWriter::new()
+                    .context(&ctx)
+                    .create_new_buffered_file(path)
+                    .map_err(|e| format!("--record {}: {e}", path.display()))?,
+            ),
+            None => None,
+        };
+        let (server, live_port) = match targets.live {
+            Some(addr) => {
+                let s = foxglove::WebSocketServer::new()
+                    .name("umbra")
+                    .context(&ctx)
+                    .bind(addr.ip().to_string(), addr.port())
+                    .start_blocking()
+                    .map_err(|e| format!("--live {addr}: {e}"))?;
+                let port = s.port();
+                (Some(s), Some(port))
+            }
+            None => (None, None),
+        };
+        let channels = Channels::new(&ctx);
+        let (to_thread, from_loop) = sync_channel::<Box<VizFrame>>(VIZ_POOL);
+        let (to_pool, pool) = sync_channel::<Box<VizFrame>>(VIZ_POOL);
+        for _ in 0..VIZ_POOL {
+            let _ = to_pool.try_send(Box::default());
+        }
+        let thread = std::thread::Builder::new()
+            .name("umbra-viz".into())
+            .spawn(move || {
+                // Channels close when their context goes: the thread keeps it.
+                let _ctx = ctx;
+                for frame in from_loop.iter() {
+                    channels.log(&frame);
+                    let _ = to_pool.try_send(frame);
+                }
+                if let Some(s) = server {
+                    s.stop().wait_blocking();
+                }
+                match mcap {
+                    Some(w) => w.close().map(|_| ()).map_err(|e| format!("--record: {e}")),
+                    None => Ok(()),
+                }
+            })
+            .map_err(|e| format!("cannot start the viz thread: {e}"))?;
+        Ok(VizLink {
+            to_thread: Some(to_thread),
+            pool,
+            thread: Some(thread),
+            dropped: 0,
+            sent: 0,
+            live_port,
+        })
+    }
+
+    /// The live server's port (useful with port 0).
+    pub fn live_port(&self) -> Option<u16> {
+        self.live_port
+    }
+
+    /// Hands one frame to the viz thread: `fill` writes it into a pooled box. Without a free
+    /// box (the thread is behind) the frame is dropped and counted. Allocates nothing.
+    pub fn send(&mut self, fill: impl FnOnce(&mut VizFrame)) {
+        let Ok(mut frame) = self.pool.try_recv() else {
+            self.dropped += 1;
+            return;
+        };
+        fill(&mut frame);
+        match self.to_thread.as_ref().map(|tx| tx.try_send(frame)) {
+            Some(Ok(())) => self.sent += 1,
+            Some(Err(TrySendError::Full(_) | TrySendError::Disconnected(_))) | None => {
+                self.dropped += 1
+            }
+        }
+    }
+
+    /// Frames dropped because the viz thread was behind.
+    pub fn dropped(&self) -> u64 {
+        self.dropped
+    }
+
+    /// Frames handed over.
+    pub fn sent(&self) -> u64 {
+        self.sent
+    }
+
+    /// Lets the thread finish what it has, closes the MCAP file and stops the server.
+    pub fn finish(mut self) -> Result<(), String> {
+        self.to_thread = None;
+        match self.thread.take().map(|t| t.join()) {
+            Some(Ok(r)) => r,
+            Some(Err(_)) => Err("the viz thread panicked".into()),
+            None => Ok(()),
+        }
+    }
+}
+
+impl Drop for VizLink {
+    fn drop(&mut self) {
+        self.to_thread = None;
+        if let Some(t) = self.thread.take() {
+            let _ = t.join();
+        }
+    }
+}
+
+struct Channels {
+    scan: Channel<LaserScan>,
+    tf: Channel<FrameTransforms>,
+    pose: Channel<PoseInFrame>,
+    scene: Channel<SceneUpdate>,
+}
+
+fn ts(t: f64) -> Option<Timestamp> {
+    Some(Timestamp::saturating_from_epoch_secs_f64(t.max(0.0)))
+}
+
+fn pose3(x: f64, y: f64, z: f64, theta: f64) -> Option<Pose> {
+    Some(Pose {
+        position: Some(Vector3 { x, y, z }),
+        orientation: Some(yaw(theta)),
+    })
+}
+
+fn yaw(theta: f64) -> Quaternion {
+    Quaternion {
+        x: 0.0,
+        y: 0.0,
+        z: (theta / 2.0).sin(),
+        w: (theta / 2.0).cos(),
+    }
+}
+
+/// Colour of a class (Okabe–Ito, readable by colour-blind viewers).
+fn colour(class: &str) -> Color {
+    let (r, g, b) = match class {
+        "chair" => (0.90, 0.62, 0.0),
+        "box" => (0.34, 0.71, 0.91),
+        "desk" => (0.0, 0.62, 0.45),
+        "door_frame" => (0.80, 0.47, 0.65),
+        _ => (0.6, 0.6, 0.6),
+    };
+    Color { r, g, b, a: 0.8 }
+}
+
+impl Channels {
+    fn new(ctx: &Arc<Context>) -> Self {
+        Channels {
+            scan: ChannelBuilder::new("/scan").context(ctx).build(),
+            tf: ChannelBuilder::new("/tf").context(ctx).build(),
+            pose: ChannelBuilder::new("/pose").context(ctx).build(),
+            scene: ChannelBuilder::new("/perception").context(ctx).build(),
+        }
+    }
+
+    fn log(&self, f: &VizFrame) {
+        let stamp = ts(f.t);
+        self.scan.log(&LaserScan {
+            timestamp: stamp,
+            frame_id: "lidar".into(),
+            pose: pose3(0.0, 0.0, 0.0, 0.0),
+            start_angle: 0.0,
+            end_angle: (SCAN_COLUMNS as f64 - 1.0).to_radians(),
+            ranges: f
+                .ranges
+                .iter()
+                .map(|&r| if r > 0.0 { f64::from(r) } else { f64::NAN })
+                .collect(),
+            intensities: Vec::new(),
+        });
+        let (p, m) = (&f.pose, &f.mount);
+        self.tf.log(&FrameTransforms {
+            transforms: vec![
+                FrameTransform {
+                    timestamp: stamp,
+                    parent_frame_id: "map".into(),
+                    child_frame_id: "base_link".into(),
+                    translation: Some(Vector3 {
+                        x: f64::from(p.x),
+                        y: f64::from(p.y),
+                        z: 0.0,
+                    }),
+                    rotation: Some(yaw(f64::from(p.theta))),
+                },
+                FrameTransform {
+                    timestamp: stamp,
+                    parent_frame_id: "base_link".into(),
+                    child_frame_id: "lidar".into(),
+                    translation: Some(Vector3 {
+                        x: f64::from(m.x),
+                        y: f64::from(m.y),
+                        z: 0.17,
+                    }),
+                    rotation: Some(yaw(f64::from(m.theta))),
+                },
+            ],
+        });
+        self.pose.log(&PoseInFrame {
+            timestamp: stamp,
+            frame_id: "map".into(),
+            pose: pose3(f64::from(p.x), f64::from(p.y), 0.0, f64::from(p.theta)),
+        });
+        let objects = SceneEntity {
+            timestamp: stamp,
+            frame_id: "map".into(),
+            id: "objects".into(),
+            cubes: f
+                .objects
+                .iter()
+                .map(|o| CubePrimitive {
+                    pose: pose3(o.x, o.y, 0.2, 0.0),
+                    size: Some(Vector3 {
+                        x: 0.4,
+                        y: 0.4,
+                        z: 0.4,
+                    }),
+                    color: Some(colour(o.class)),
+                })
+                .chain(f.doors.iter().map(|d| CubePrimitive {
+                    pose: pose3(d.x, d.y, 1.0, 0.0),
+                    size: Some(Vector3 {
+                        x: 0.05,
+                        y: d.width,
+                        z: 2.0,
+                    }),
+                    color: Some(colour("door_frame")),
+                }))
+                .collect(),
+            texts: f
+                .objects
+                .iter()
+                .map(|o| TextPrimitive {
+                    pose: pose3(o.x, o.y, 0.6, 0.0),
+                    billboard: true,
+                    font_size: 14.0,
+                    scale_invariant: true,
+                    color: Some(Color {
+                        r: 1.0,
+                        g: 1.0,
+                        b: 1.0,
+                        a: 1.0,
+                    }),
+                    text: format!("{} {:.2} {}", o.class, o.score, o.source),
+                })
+                .collect(),
+            lines: vec![LinePrimitive {
+                r#type: line_primitive::Type::LineList as i32,
+                pose: pose3(0.0, 0.0, 0.0, 0.0),
+                thickness: 0.03,
+                scale_invariant: false,
+                points: f
+                    .walls
+                    .iter()
+                    .flat_map(|w| {
+                        [
+                            Point3 {
+                                x: w.x0,
+                                y: w.y0,
+                                z: 0.0,
+                            },
+                            Point3 {
+                                x: w.x1,
+                                y: w.y1,
+                                z: 0.0,
+                            },
+                        ]
+                    })
+                    .collect(),
+                color: Some(Color {
+                    r: 0.85,
+                    g: 0.85,
+                    b: 0.85,
+                    a: 1.0,
+                }),
+                colors: Vec::new(),
+                indices: Vec::new(),
+            }],
+            ..Default::default()
+        };
+        self.scene.log(&SceneUpdate {
+            deletions: Vec::new(),
+            entities: vec![objects],
+        });
+    }
+}
