@@ -195,7 +195,7 @@ def main() -> None:
     ap.add_argument("--ood-scenarios", type=int, default=40)
     ap.add_argument("--ood-kinds", default="lshape")
     ap.add_argument("--ood-clutter", type=int, default=6)
-    ap.add_argument("--epochs", type=int, default=24)
+    ap.add_argument("--epochs", type=int, default=14)
     ap.add_argument("--batch", type=int, default=32)
     ap.add_argument("--mirror", type=float, default=0.5)
     ap.add_argument("--device", default="cpu")
