@@ -101,7 +101,7 @@ def evaluate(lab: Path, sim_sets: dict, work: Path, threads: int) -> dict:
         "what": "Ultralytics validation (training/ultra_val.py: DetectionValidator, 64x384 "
                 "unpadded) of the checkpoint exported to models/yolo/umbra-yolov8n.onnx",
         "dataset": {"command": "umbra-sim dataset " + " ".join(REFERENCE), "split": "test",
-                    "images": ref.get("images")},
+                    "images": len(list((work / "reference" / "images" / "test").glob("*.png")))},
         "weights_sha256": sha256(MODELS / "umbra-yolov8n.pt"),
         **{k: v for k, v in ref.items() if k != "images"},
     }
