@@ -7,8 +7,9 @@
 //!
 //! The overrun policy ([`Policy`]), in the order the runtime applies it:
 //! 1. **Skip Method B** when the time left in the frame is less than Method B's expected time
-//!    (the larger of its last time and its decaying average), and **decimate** it (every other
-//!    frame) while the loop is behind the LiDAR.
+//!    (the larger of its last time and its decaying average; a skipped frame lowers both, so
+//!    Method B is tried again after a hiccup), and **decimate** it (every other frame) while
+//!    the loop is behind the LiDAR.
 //! 2. **Shrink the cloud's work** when Method A overran its own budget on the previous frame:
 //!    the cloud ages [`SHRINK_DROP_FRACTION`] of its points instead of the configured share, so
 //!    clustering sees fewer.
@@ -216,6 +217,13 @@ impl Policy {
     pub fn before_method_b(&mut self, budgets: &Budgets, elapsed_ms: f64, behind: bool) -> bool {
         let expected = self.b_avg_ms.max(self.b_last_ms);
         let no_room = expected > 0.0 && elapsed_ms + expected > budgets.deadline_ms;
+        if no_room {
+            // A skipped Method B is not measured: let its estimate decay so that one slow
+            // frame (a hiccup of the machine) cannot shut it out for good; it is tried again
+            // within a few frames and, if still too slow, skipped again.
+            self.b_last_ms *= 0.5;
+            self.b_avg_ms *= 0.8;
+        }
         let decimate = if behind {
             self.behind_frames += 1;
             self.behind_frames.is_multiple_of(2)
@@ -432,6 +440,28 @@ mod tests {
         let runs: Vec<bool> = (0..4).map(|_| p.before_method_b(&b, 0.0, true)).collect();
         assert_eq!(runs, [false, true, false, true]);
         assert!(!p.before_method_b(&b, 0.0, false));
+    }
+
+    #[test]
+    fn one_slow_method_b_frame_does_not_shut_it_out() {
+        // The 18,000-frame soak on a loaded machine: one 364 ms Method B frame, and the old
+        // policy skipped Method B for the rest of the run.
+        let b = Budgets {
+            deadline_ms: 250.0,
+            ..budgets()
+        };
+        let mut p = Policy::default();
+        for _ in 0..20 {
+            p.method_b_took(8.0);
+        }
+        p.method_b_took(364.0);
+        let skipped = (0..20)
+            .take_while(|_| p.before_method_b(&b, 1.0, false))
+            .count();
+        assert!(
+            (1..=5).contains(&skipped),
+            "tried again after {skipped} frames"
+        );
     }
 
     #[test]
