@@ -83,6 +83,19 @@ pub struct TimingOut {
     pub total: f64,
 }
 
+impl From<crate::deadline::FrameTimes> for TimingOut {
+    fn from(t: crate::deadline::FrameTimes) -> Self {
+        TimingOut {
+            ingest: t.ingest,
+            pose: t.pose,
+            method_a: t.method_a,
+            method_b: t.method_b,
+            output: t.output,
+            total: t.total,
+        }
+    }
+}
+
 /// Cumulative fault counters (`interfaces.md` names first, extra keys after).
 #[derive(Debug, Clone, Copy, Serialize, Default, PartialEq, Eq)]
 pub struct FaultsOut {

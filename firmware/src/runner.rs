@@ -766,19 +766,15 @@ fn emit_frame(
     rec.method_b_skipped += u64::from(skip_b);
     rec.cloud_shrunk += u64::from(shrink);
     rec.behind_lidar += u64::from(behind);
-    rec.record(
-        &FrameTimes {
-            ingest: ingest_ms,
-            pose: pose_ms,
-            method_a: method_a_ms,
-            method_b: method_b_ms,
-            output: output_ms,
-            total: total_ms,
-        },
-        &opts.budgets,
-        missed,
-        degraded,
-    );
+    let times = FrameTimes {
+        ingest: ingest_ms,
+        pose: pose_ms,
+        method_a: method_a_ms,
+        method_b: method_b_ms,
+        output: output_ms,
+        total: total_ms,
+    };
+    rec.record(&times, &opts.budgets, missed, degraded);
     let power_w = opts.power.as_mut().and_then(|p| p.watts());
     if let Some(w) = power_w {
         state.power_sum += w;
@@ -798,14 +794,7 @@ fn emit_frame(
             objects: &state.objects,
             walls: &state.walls,
             doors: &state.doors,
-            timing_ms: TimingOut {
-                ingest: ingest_ms,
-                pose: pose_ms,
-                method_a: method_a_ms,
-                method_b: method_b_ms,
-                output: output_ms,
-                total: total_ms,
-            },
+            timing_ms: TimingOut::from(times),
             deadline_ms: opts.budgets.deadline_ms,
             deadline_missed: missed,
             degraded,
