@@ -456,7 +456,7 @@ fn print_summary(s: &Summary) {
         s.invalid_readings,
         s.link.0,
         s.link.1,
-        s.deadline_missed
+        s.deadlines.missed
     );
     if s.viz_dropped > 0 {
         eprintln!(

@@ -246,11 +246,6 @@ impl core::fmt::Display for StatsLine<'_> {
     }
 }
 
-/// The human-readable per-revolution line as a string.
-pub fn stats_line(frame: u64, rev: &Revolution) -> String {
-    StatsLine { frame, rev }.to_string()
-}
-
 #[cfg(test)]
 mod test {
     use super::*;
