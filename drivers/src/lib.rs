@@ -7,10 +7,14 @@
 //!
 //! | module      | owns                                                          | needs  |
 //! |-------------|---------------------------------------------------------------|--------|
+//! | [`lidar`]   | the revolution every model yields, the `LidarStream` trait, auto-detection | core |
 //! | [`lds01`]   | LDS-01 packets, streaming decoder, revolution assembler        | core   |
+//! | [`ldrobot`] | LDS-02 (LD08), LD06, LD19: 47-byte CRC-8 frames → revolutions  | core   |
+//! | [`rplidar`] | RPLIDAR A1/A2: SCAN descriptor, 5-byte nodes, motor sequences  | core   |
 //! | `compass`   | LSM303AGR magnetometer over embedded-hal 1.0 I²C (`lsm303agr`), bounded waits | `compass` |
 //! | [`dynamixel`] | DYNAMIXEL Protocol 2.0 (OpenCR): CRC-16, stuffing, instruction emit, status decoder | core |
 //! | `serial`    | serial ports via `serialport`, as `embedded-io`; reopen with back-off | `std`  |
+//! | `probe`     | which LiDAR is on a port: baud rates tried, bytes recognised, diagnosis | `std` |
 //! | `opencr`    | OpenCR wheel encoders over DYNAMIXEL 2.0, timeouts, counted errors | `std`  |
 //!
 //! ## Guarantees
@@ -32,8 +36,13 @@
 #[cfg(feature = "compass")]
 pub mod compass;
 pub mod dynamixel;
+pub mod ldrobot;
 pub mod lds01;
+pub mod lidar;
 #[cfg(feature = "std")]
 pub mod opencr;
+#[cfg(feature = "std")]
+pub mod probe;
+pub mod rplidar;
 #[cfg(feature = "std")]
 pub mod serial;

@@ -38,6 +38,9 @@ pub struct SerialConfig {
     pub on_open: &'static [u8],
     /// Bytes written before closing (the LDS-01's motor stop `e`).
     pub on_close: &'static [u8],
+    /// RPLIDAR: run [`crate::rplidar::motor::start`] after every open (DTR released, SCAN)
+    /// and [`crate::rplidar::motor::stop`] before closing (STOP, 100 ms, DTR asserted).
+    pub rplidar_motor: bool,
 }
 
 impl SerialConfig {
@@ -51,6 +54,7 @@ impl SerialConfig {
             backoff_max: Duration::from_secs(2),
             on_open: &[],
             on_close: &[],
+            rplidar_motor: false,
         }
     }
 
@@ -63,8 +67,63 @@ impl SerialConfig {
             backoff_max: Duration::from_secs(2),
             on_open: &[crate::lds01::link::START_MOTOR],
             on_close: &[crate::lds01::link::STOP_MOTOR],
+            rplidar_motor: false,
         }
     }
+
+    /// Any LiDAR model at its native baud rate: the LDS-01's start/stop bytes, nothing for
+    /// the LDROBOT models (TX only), the DTR + SCAN / STOP sequences for the RPLIDAR.
+    pub fn lidar(model: crate::lidar::LidarModel) -> Self {
+        use crate::lidar::Family;
+        let base = SerialConfig {
+            baud: model.baud(),
+            ..SerialConfig::lds01()
+        };
+        match model.family() {
+            Family::Lds01 => base,
+            Family::Ldrobot => SerialConfig {
+                on_open: &[],
+                on_close: &[],
+                ..base
+            },
+            Family::Rplidar => SerialConfig {
+                on_open: &[],
+                on_close: &[],
+                rplidar_motor: true,
+                ..base
+            },
+        }
+    }
+}
+
+/// [`crate::rplidar::motor::MotorLink`] over an open port. DTR cannot be set on every device
+/// (a pseudo-terminal refuses it): such a failure is logged, not fatal, since the bytes still
+/// go out.
+struct PortMotor<'a>(&'a mut Port);
+
+impl crate::rplidar::motor::MotorLink for PortMotor<'_> {
+    type Error = ErrorKind;
+    fn set_dtr(&mut self, asserted: bool) -> Result<(), ErrorKind> {
+        if let Err(e) = self.0.inner_mut().write_data_terminal_ready(asserted) {
+            log::debug!("cannot set DTR ({e}): motor line left as it is");
+        }
+        Ok(())
+    }
+    fn write_all(&mut self, bytes: &[u8]) -> Result<(), ErrorKind> {
+        write_all(self.0, bytes)
+    }
+    fn delay_ms(&mut self, ms: u32) {
+        std::thread::sleep(Duration::from_millis(u64::from(ms)));
+    }
+}
+
+/// Sends what a device needs after an open.
+pub(crate) fn run_on_open(port: &mut Port, cfg: &SerialConfig) -> Result<(), ErrorKind> {
+    write_all(port, cfg.on_open)?;
+    if cfg.rplidar_motor {
+        crate::rplidar::motor::start(&mut PortMotor(port), None)?;
+    }
+    Ok(())
 }
 
 /// A link failure, naming the device.
@@ -189,7 +248,7 @@ impl SerialLink {
     /// an error (the user named it); losses after that are survived.
     pub fn open(path: &str, cfg: SerialConfig) -> Result<Self, LinkError> {
         let mut port = open_port(path, &cfg)?;
-        write_all(&mut port, cfg.on_open).map_err(|kind| LinkError::Io {
+        run_on_open(&mut port, &cfg).map_err(|kind| LinkError::Io {
             path: path.to_owned(),
             kind,
         })?;
@@ -201,6 +260,18 @@ impl SerialLink {
             next_try: Instant::now(),
             stats: LinkStats::default(),
         })
+    }
+
+    /// Wraps a port already open and started (by [`crate::probe::probe`]).
+    pub fn from_open(path: &str, cfg: SerialConfig, port: Port) -> Self {
+        SerialLink {
+            path: path.to_owned(),
+            backoff: cfg.backoff_min,
+            cfg,
+            port: Some(port),
+            next_try: Instant::now(),
+            stats: LinkStats::default(),
+        }
     }
 
     /// Device path.
@@ -295,7 +366,7 @@ impl SerialLink {
         }
         match open_port(&self.path, &self.cfg) {
             Ok(mut port) => {
-                if write_all(&mut port, self.cfg.on_open).is_err() {
+                if run_on_open(&mut port, &self.cfg).is_err() {
                     self.stats.failed_reopens += 1;
                     self.schedule_retry();
                     return LinkRead::Idle;
@@ -319,11 +390,20 @@ impl SerialLink {
     }
 }
 
+/// Sends what a device needs before a close.
+pub(crate) fn run_on_close(port: &mut Port, cfg: &SerialConfig) -> Result<(), ErrorKind> {
+    write_all(port, cfg.on_close)?;
+    if cfg.rplidar_motor {
+        crate::rplidar::motor::stop(&mut PortMotor(port), false)?;
+    }
+    Ok(())
+}
+
 impl Drop for SerialLink {
     fn drop(&mut self) {
         if let Some(port) = self.port.as_mut() {
             // Best effort: the device may already be gone.
-            let _ = write_all(port, self.cfg.on_close);
+            let _ = run_on_close(port, &self.cfg);
         }
     }
 }

@@ -62,7 +62,7 @@ pub struct CalibrateArgs {
 /// LiDAR models (`--lidar-model`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
 pub enum LidarModel {
-    /// Tell the model from the bytes (only the LDS-01 is supported so far).
+    /// Tell the model from the bytes (baud rates probed on a port; framing in a capture).
     Auto,
     /// ROBOTIS LDS-01 (HLS-LFCD2).
     Lds01,

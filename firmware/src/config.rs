@@ -578,6 +578,19 @@ impl Config {
         }
     }
 
+    /// The LiDAR stream settings for `model`: the `[lidar]` range window applies to every
+    /// model (it is the pipeline's working range, which Method A's thresholds and Method B's
+    /// training data assume), the checksum policy to the LDS-01 only.
+    pub fn lidar(&self, _model: drivers::lidar::LidarModel) -> drivers::lidar::LidarConfig {
+        let l = self.lds01();
+        drivers::lidar::LidarConfig {
+            min_range_m: Some(l.assembler.min_range_m),
+            max_range_m: Some(l.assembler.max_range_m),
+            stale_after_us: l.assembler.stale_after_us,
+            lds01_checksum: l.checksum,
+        }
+    }
+
     /// The LDS-01 driver settings.
     pub fn lds01(&self) -> Lds01Config {
         Lds01Config {

@@ -44,10 +44,23 @@ fn dispatch(cli: Cli) -> Result<(), Failure> {
     match cli.command {
         Command::Run(args) => {
             let cfg = load_config(&args.common)?;
-            check_lidar_model(args.common.lidar_model)?;
+            let named = named_model(args.common.lidar_model);
             let mut source = match &args.lidar {
-                Some(port) => LidarSource::serial(port).map_err(|m| (EXIT_FAULT, m))?,
-                None => LidarSource::sim(args.seed, args.seed),
+                Some(port) => {
+                    let (source, how) =
+                        LidarSource::serial(port, named).map_err(|m| (EXIT_FAULT, m))?;
+                    log::info!("LiDAR: {how}");
+                    source
+                }
+                None => {
+                    if named.is_some_and(|m| m != drivers::lidar::LidarModel::Lds01) {
+                        return Err((
+                            EXIT_USAGE,
+                            "--lidar-model: the built-in simulated robot carries an LDS-01 (emit other models with `umbra-sim capture --model`)".into(),
+                        ));
+                    }
+                    LidarSource::sim(args.seed, args.seed)
+                }
             };
             println!("umbra: {}", source.describe());
             let opencr = match &args.opencr {
@@ -216,8 +229,10 @@ fn dispatch(cli: Cli) -> Result<(), Failure> {
         }
         Command::Replay(args) => {
             let cfg = load_config(&args.common)?;
-            check_lidar_model(args.common.lidar_model)?;
-            let mut source = LidarSource::capture(&args.capture).map_err(|m| (EXIT_USAGE, m))?;
+            let named = named_model(args.common.lidar_model);
+            let (mut source, how) =
+                LidarSource::capture(&args.capture, named).map_err(|m| (EXIT_USAGE, m))?;
+            log::info!("LiDAR: {how}");
             println!("umbra: {}", source.describe());
             let pose = match &args.odom {
                 Some(path) => {
@@ -286,16 +301,17 @@ fn load_config(common: &Common) -> Result<Config, Failure> {
     }
 }
 
-fn check_lidar_model(model: LidarModel) -> Result<(), Failure> {
+/// The model `--lidar-model` names (`None` for `auto`).
+fn named_model(model: LidarModel) -> Option<drivers::lidar::LidarModel> {
+    use drivers::lidar::LidarModel as M;
     match model {
-        LidarModel::Auto | LidarModel::Lds01 => Ok(()),
-        other => Err((
-            EXIT_USAGE,
-            format!(
-                "--lidar-model {other:?}: only the LDS-01 is supported so far (its issue is open)"
-            )
-            .to_lowercase(),
-        )),
+        LidarModel::Auto => None,
+        LidarModel::Lds01 => Some(M::Lds01),
+        LidarModel::Lds02 => Some(M::Lds02),
+        LidarModel::Ld06 => Some(M::Ld06),
+        LidarModel::Ld19 => Some(M::Ld19),
+        LidarModel::RplidarA1 => Some(M::RplidarA1),
+        LidarModel::RplidarA2 => Some(M::RplidarA2),
     }
 }
 
@@ -360,7 +376,8 @@ fn run_loop(
         viz,
         snapshot: common.snapshot.clone(),
     };
-    let summary = runner::run(source, cfg.lds01(), opts)
+    let stream = drivers::lidar::AnyLidar::new(source.model(), &cfg.lidar(source.model()));
+    let summary = runner::run(source, stream, opts)
         .map_err(|e| (EXIT_FAULT, format!("cannot write output: {e}")))?;
     print_summary(&summary);
     Ok(())

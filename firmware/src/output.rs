@@ -3,7 +3,7 @@
 
 use std::io::{self, Write};
 
-use drivers::lds01::{Lds01Faults, Revolution};
+use drivers::lidar::{LidarFaults, Revolution};
 use serde::Serialize;
 
 /// Pose in the map frame.
@@ -101,15 +101,15 @@ impl From<crate::deadline::FrameTimes> for TimingOut {
 pub struct FaultsOut {
     /// Bytes not part of any packet passed on.
     pub lidar_bytes_skipped: u64,
-    /// Packets whose checksum failed.
+    /// Packets (LDS-01) or frames (LDROBOT CRC-8) whose checksum failed.
     pub lidar_bad_checksum: u64,
-    /// Packets missing from revolutions.
+    /// Packets (LDS-01) or 6° sectors (other models) missing from revolutions.
     pub lidar_missing_packets: u64,
     /// Wheel-encoder errors: bad odometry lines or samples.
     pub encoder_errors: u64,
     /// Compass readings the pose filter rejected (disturbance).
     pub compass_rejected: u64,
-    /// Sync bytes followed by a bad index.
+    /// Sync bytes followed by a bad index (LDS-01); nodes with an angle ≥ 360° (RPLIDAR).
     pub lidar_bad_index: u64,
     /// Packets received twice.
     pub lidar_repeated_packets: u64,
@@ -120,6 +120,11 @@ pub struct FaultsOut {
     /// Readings dropped as invalid (no return, or outside the range window), in received
     /// packets.
     pub lidar_invalid_readings: u64,
+    /// LDROBOT frames with a good CRC dropped by the plausibility filter (or speed 0).
+    pub lidar_implausible_frames: u64,
+    /// Errors the LiDAR reported itself (LDROBOT health frames: blocked motor, occlusion;
+    /// RPLIDAR health replies with status error).
+    pub lidar_sensor_errors: u64,
     /// Link losses (read errors, hang-ups).
     pub lidar_link_lost: u64,
     /// Link reopens.
@@ -143,7 +148,7 @@ pub struct FaultsOut {
 
 impl FaultsOut {
     /// From the LiDAR stream's counters and the link's.
-    pub fn new(f: &Lds01Faults, invalid_readings: u64, link: (u64, u64)) -> Self {
+    pub fn new(f: &LidarFaults, invalid_readings: u64, link: (u64, u64)) -> Self {
         FaultsOut {
             lidar_bytes_skipped: f.bytes_skipped,
             lidar_bad_checksum: f.bad_checksum,
@@ -155,6 +160,8 @@ impl FaultsOut {
             lidar_out_of_sequence_bad_packets: f.out_of_sequence_bad_packets,
             lidar_incomplete_revolutions: f.incomplete_revolutions,
             lidar_invalid_readings: invalid_readings,
+            lidar_implausible_frames: f.implausible_frames,
+            lidar_sensor_errors: f.sensor_errors,
             lidar_link_lost: link.0,
             lidar_link_reopened: link.1,
             ..FaultsOut::default()

@@ -18,7 +18,7 @@ use std::time::{Duration, Instant};
 
 use std::collections::VecDeque;
 
-use drivers::lds01::{Lds01Config, Lds01Faults, Lds01Stream};
+use drivers::lidar::{AnyLidar, LidarFaults, LidarStream};
 use perception::cloud::Scan;
 use perception::geometry::{Point2, Pose2};
 use perception::method_a::{MethodA, MethodAConfig};
@@ -289,7 +289,7 @@ pub struct Summary {
     /// Bytes read.
     pub bytes: u64,
     /// Final fault counters.
-    pub faults: Lds01Faults,
+    pub faults: LidarFaults,
     /// Readings marked invalid.
     pub invalid_readings: u64,
     /// Link losses and reopens.
@@ -320,17 +320,12 @@ impl Summary {
     }
 }
 
-/// Bytes of one LDS-01 revolution on the wire (60 packets of 42 bytes): more than this queued
-/// on the port means the loop has fallen behind the LiDAR.
-pub const REVOLUTION_BYTES: u32 = 60 * drivers::lds01::PACKET_LEN as u32;
-
 /// Runs the loop until a limit, the end of the source, or the stop flag.
 pub fn run(
     source: &mut LidarSource,
-    cfg: Lds01Config,
+    mut stream: AnyLidar,
     mut opts: RunOptions,
 ) -> Result<Summary, std::io::Error> {
-    let mut stream = Lds01Stream::new(cfg);
     let mut buf = [0u8; READ_CHUNK];
     let start = Instant::now();
     let mut summary = Summary::default();
@@ -379,7 +374,7 @@ pub fn run(
             SourceRead::Data(n) => n,
             SourceRead::Idle => {
                 if !source.is_file()
-                    && stream.poll(link_us(state.busy), |_| {})
+                    && stream.poll(link_us(state.busy)).is_some()
                     && emit_frame(
                         &stream,
                         source,
@@ -394,7 +389,7 @@ pub fn run(
                 continue;
             }
             SourceRead::End => {
-                if stream.finish(|_| {}) {
+                if stream.finish().is_some() {
                     emit_frame(
                         &stream,
                         source,
@@ -507,12 +502,12 @@ fn behind_lidar(
     source: &LidarSource,
     backlog_bytes: Option<u32>,
     pacing: Pacing,
-    stream: &Lds01Stream,
+    stream: &AnyLidar,
     start: &Instant,
     period_s: f64,
 ) -> bool {
     if let Some(queued) = backlog_bytes {
-        return queued > REVOLUTION_BYTES;
+        return queued > stream.model().bytes_per_revolution();
     }
     source.is_simulated()
         && pacing == Pacing::RealTime
@@ -611,7 +606,7 @@ fn method_b_frame(b: &mut MethodBSetup, state: &mut FrameState) -> Result<(), St
 /// Writes the stream's last finished revolution as one frame; returns `true` when the frame
 /// limit is reached.
 fn emit_frame(
-    stream: &Lds01Stream,
+    stream: &AnyLidar,
     source: &LidarSource,
     opts: &mut RunOptions,
     summary: &mut Summary,
@@ -628,7 +623,9 @@ fn emit_frame(
     if rev.is_complete() {
         summary.complete += 1;
     }
-    summary.invalid_readings += u64::from(rev.packets) * 6 - u64::from(valid);
+    summary.invalid_readings += (u64::from(rev.packets)
+        * drivers::lidar::revolution::BINS_PER_SECTOR as u64)
+        .saturating_sub(u64::from(valid));
 
     if let Some(w) = opts.stats.as_mut() {
         writeln!(w, "{}", StatsLine { frame, rev })?;

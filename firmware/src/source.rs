@@ -5,6 +5,8 @@ use std::fs::File;
 use std::path::{Path, PathBuf};
 
 use drivers::lds01::PACKET_LEN;
+use drivers::lidar::LidarModel;
+use drivers::lidar::detect::{Detector, Verdict};
 use drivers::serial::{LinkRead, SerialConfig, SerialLink};
 use embedded_io::Read as _;
 use embedded_io_adapters::std::FromStd;
@@ -39,14 +41,16 @@ pub enum Pacing {
 
 /// A LiDAR byte source.
 pub enum LidarSource {
-    /// A serial port that reopens itself.
-    Serial(SerialLink),
+    /// A serial port that reopens itself, and the model on it.
+    Serial(SerialLink, LidarModel),
     /// A raw capture file read through `embedded-io`.
     Capture {
         /// The file's path, for messages.
         path: PathBuf,
         /// The file.
         file: FromStd<File>,
+        /// The model whose bytes it holds.
+        model: LidarModel,
     },
     /// The built-in simulated robot.
     Sim {
@@ -59,25 +63,102 @@ pub enum LidarSource {
     },
 }
 
+/// How long the prober listens at each baud rate, ms (a few revolutions of any model).
+pub const PROBE_LISTEN_MS: u64 = 1500;
+/// Bytes of a capture read to recognise its model (several revolutions of any model).
+pub const DETECT_BYTES: usize = 64 * 1024;
+
 /// Packets the simulated source produces per read (a tenth of a revolution).
 pub const SIM_PACKETS_PER_READ: usize = 6;
 
 impl LidarSource {
-    /// Opens a serial port for the LDS-01.
-    pub fn serial(path: &str) -> Result<Self, String> {
-        SerialLink::open(path, SerialConfig::lds01())
-            .map(LidarSource::Serial)
-            .map_err(|e| e.to_string())
+    /// Opens a serial port for `model`, or (`None`) finds out which LiDAR is there
+    /// ([`drivers::probe`]); the second value says what was found. A port where no LiDAR is
+    /// recognised is an error naming the port and, per baud rate, what was seen.
+    pub fn serial(path: &str, model: Option<LidarModel>) -> Result<(Self, String), String> {
+        if let Some(model) = model {
+            return SerialLink::open(path, SerialConfig::lidar(model))
+                .map(|l| {
+                    (
+                        LidarSource::Serial(l, model),
+                        format!("{model} named on {path}"),
+                    )
+                })
+                .map_err(|e| e.to_string());
+        }
+        let probe = drivers::probe::probe(
+            path,
+            &drivers::probe::PROBE_BAUDS,
+            std::time::Duration::from_millis(PROBE_LISTEN_MS),
+        )
+        .map_err(|e| e.to_string())?;
+        let summary = probe.summary();
+        match probe.found {
+            Some((model, baud, port)) => {
+                let cfg = SerialConfig {
+                    baud,
+                    ..SerialConfig::lidar(model)
+                };
+                Ok((
+                    LidarSource::Serial(SerialLink::from_open(path, cfg, port), model),
+                    summary,
+                ))
+            }
+            None => Err(summary),
+        }
     }
 
-    /// Opens a raw capture file.
-    pub fn capture(path: &Path) -> Result<Self, String> {
-        let file =
-            File::open(path).map_err(|e| format!("cannot open capture {}: {e}", path.display()))?;
-        Ok(LidarSource::Capture {
-            path: path.to_owned(),
-            file: FromStd::new(file),
-        })
+    /// Opens a raw capture file of `model`, or (`None`) recognises the model from its first
+    /// [`DETECT_BYTES`] bytes. A file in which no model's frames are found is an error.
+    pub fn capture(path: &Path, model: Option<LidarModel>) -> Result<(Self, String), String> {
+        let open =
+            || File::open(path).map_err(|e| format!("cannot open capture {}: {e}", path.display()));
+        let (model, how) = match model {
+            Some(m) => (m, format!("{m} named")),
+            None => {
+                let mut head = Vec::with_capacity(DETECT_BYTES);
+                std::io::Read::read_to_end(
+                    &mut std::io::Read::take(open()?, DETECT_BYTES as u64),
+                    &mut head,
+                )
+                .map_err(|e| format!("cannot read capture {}: {e}", path.display()))?;
+                let mut det = Detector::new();
+                det.feed(&head);
+                let verdict = det.verdict();
+                let words = drivers::probe::describe(&verdict);
+                match verdict {
+                    Verdict::Found { model, .. } => (model, format!("recognised: {words}")),
+                    Verdict::HighErrorRate { model, .. } => {
+                        log::warn!("capture {}: {words}", path.display());
+                        (model, format!("recognised despite errors: {words}"))
+                    }
+                    _ => {
+                        return Err(format!(
+                            "capture {}: no LiDAR recognised in its first {} bytes: {words}",
+                            path.display(),
+                            head.len()
+                        ));
+                    }
+                }
+            }
+        };
+        Ok((
+            LidarSource::Capture {
+                path: path.to_owned(),
+                file: FromStd::new(open()?),
+                model,
+            },
+            how,
+        ))
+    }
+
+    /// The model whose bytes this source gives.
+    pub fn model(&self) -> LidarModel {
+        match self {
+            LidarSource::Serial(_, m) => *m,
+            LidarSource::Capture { model, .. } => *model,
+            LidarSource::Sim { .. } => LidarModel::Lds01,
+        }
     }
 
     /// The simulated robot in a seeded random room (the study's oscillation in place), with
@@ -125,8 +206,12 @@ impl LidarSource {
     /// One line saying what this source is.
     pub fn describe(&self) -> String {
         match self {
-            LidarSource::Serial(link) => format!("LDS-01 on serial port {}", link.path()),
-            LidarSource::Capture { path, .. } => format!("raw LDS-01 capture {}", path.display()),
+            LidarSource::Serial(link, model) => {
+                format!("{model} on serial port {}", link.path())
+            }
+            LidarSource::Capture { path, model, .. } => {
+                format!("raw {model} capture {}", path.display())
+            }
             LidarSource::Sim { sim, room_seed, .. } => format!(
                 "no hardware named: running on the built-in simulated robot (LDS-01; seed {room_seed}: {})",
                 sim.world().describe()
@@ -148,7 +233,7 @@ impl LidarSource {
     /// Bytes queued on a serial port, unread (`None` for other sources or a closed port).
     pub fn backlog_bytes(&self) -> Option<u32> {
         match self {
-            LidarSource::Serial(link) => link.backlog_bytes(),
+            LidarSource::Serial(link, _) => link.backlog_bytes(),
             _ => None,
         }
     }
@@ -156,13 +241,13 @@ impl LidarSource {
     /// Reads what is available into `buf`.
     pub fn read(&mut self, buf: &mut [u8]) -> SourceRead {
         match self {
-            LidarSource::Serial(link) => match link.read(buf) {
+            LidarSource::Serial(link, _) => match link.read(buf) {
                 LinkRead::Data(n) => SourceRead::Data(n),
                 LinkRead::Idle => SourceRead::Idle,
                 LinkRead::Lost(e) => SourceRead::Lost(e.to_string()),
                 LinkRead::Reopened => SourceRead::Reopened,
             },
-            LidarSource::Capture { path, file } => match file.read(buf) {
+            LidarSource::Capture { path, file, .. } => match file.read(buf) {
                 Ok(0) => SourceRead::End,
                 Ok(n) => SourceRead::Data(n),
                 Err(e) if e.kind() == std::io::ErrorKind::Interrupted => SourceRead::Idle,
@@ -184,7 +269,7 @@ impl LidarSource {
     /// Link counters of a serial source: (errors + EOFs, reopens).
     pub fn link_counts(&self) -> (u64, u64) {
         match self {
-            LidarSource::Serial(link) => {
+            LidarSource::Serial(link, _) => {
                 let s = link.stats();
                 (s.read_errors + s.eofs, s.reopens)
             }

@@ -34,4 +34,5 @@ pub mod pose_eval;
 pub mod robot;
 pub mod scenario;
 pub mod scenes_a;
+pub mod wire;
 pub mod world;

@@ -79,7 +79,9 @@ fn per_frame_with(method_b: bool, viz: Option<runner::VizLink>) -> Vec<u64> {
         snapshot: None,
     };
     let mut summary = None;
-    counted(|| summary = Some(runner::run(&mut source, cfg.lds01(), opts).expect("run")));
+    let model = source.model();
+    let stream = drivers::lidar::AnyLidar::new(model, &cfg.lidar(model));
+    counted(|| summary = Some(runner::run(&mut source, stream, opts).expect("run")));
     let summary = summary.unwrap();
     assert_eq!(summary.frames, FRAMES);
     let m = marks.lock().unwrap().clone();

@@ -16,6 +16,7 @@ use std::thread;
 use std::time::{Duration, Instant};
 
 use drivers::lds01::{Lds01Config, Lds01Stream, PACKET_LEN};
+use drivers::lidar::LidarStream as _;
 use drivers::serial::{LinkRead, SerialConfig, SerialLink};
 use serialport::TTYPort;
 use sim::lds01::{Lds01Sim, Lds01SimConfig};
@@ -152,14 +153,14 @@ fn pty_link_paced_with_garbage_and_replug() {
                 });
             }
             LinkRead::Idle => {
-                stream.poll(now, |r| {
+                if let Some(r) = stream.poll(now) {
                     revs.push(Rev {
                         seq: r.seq,
                         complete: r.is_complete(),
                         host_us: now,
                         t_start: r.t_start_s,
                     })
-                });
+                }
             }
             LinkRead::Lost(e) => {
                 println!("lost: {e}");

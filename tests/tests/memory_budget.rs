@@ -40,6 +40,41 @@ fn buffers_in_code() -> Vec<(&'static str, usize, usize)> {
             1,
             size_of::<Lds01Stream>(),
         ),
+        (
+            "drivers::ldrobot::decoder::DECODER_BUFFER_LEN",
+            drivers::ldrobot::decoder::DECODER_BUFFER_LEN,
+            1,
+        ),
+        (
+            "drivers::rplidar::decoder::DECODER_BUFFER_LEN",
+            drivers::rplidar::decoder::DECODER_BUFFER_LEN,
+            1,
+        ),
+        (
+            "size_of::<drivers::ldrobot::LdrobotStream>()",
+            1,
+            size_of::<drivers::ldrobot::LdrobotStream>(),
+        ),
+        (
+            "size_of::<drivers::rplidar::RplidarStream>()",
+            1,
+            size_of::<drivers::rplidar::RplidarStream>(),
+        ),
+        (
+            "size_of::<drivers::lidar::AnyLidar>()",
+            1,
+            size_of::<drivers::lidar::AnyLidar>(),
+        ),
+        (
+            "size_of::<drivers::lidar::detect::Detector>()",
+            1,
+            size_of::<drivers::lidar::detect::Detector>(),
+        ),
+        (
+            "firmware::source::DETECT_BYTES",
+            firmware::source::DETECT_BYTES,
+            1,
+        ),
         ("firmware::runner::READ_CHUNK", READ_CHUNK, 1),
         ("drivers::dynamixel::MAX_PACKET_LEN", MAX_PACKET_LEN, 1),
         (

@@ -6,14 +6,17 @@
 //! |---------------|------------------------------------------------------------------|
 //! | [`packet`]    | the 42-byte packet: checked view, parsed form, checksum, `emit`  |
 //! | [`decoder`]   | bytes in any chunking → packets; resync; checksum policy; counters |
-//! | [`revolution`]| 360 readings in REP 103 angles, validity, time stamps            |
 //! | [`assembler`] | packets → revolutions; missing/repeated packets; sensor clock    |
-//! | this module   | [`Lds01Stream`], the two glued together, and [`Lds01Faults`]     |
+//! | this module   | [`Lds01Stream`], the two glued together, as a [`LidarStream`]   |
+//!
+//! The revolution type is every model's ([`crate::lidar::revolution`]); an LDS-01 packet is
+//! one of its 6° sectors.
 //!
 //! Everything here is `no_std` and allocation-free; sizes are in `memory-budget.md`.
 //!
 //! ```
 //! use drivers::lds01::{Lds01Config, Lds01Stream, Repr, RawReading, PACKET_LEN};
+//! use drivers::lidar::LidarStream;
 //!
 //! // Emit one revolution the way the simulator does, then decode it.
 //! let mut bytes = [0u8; 60 * PACKET_LEN];
@@ -35,15 +38,19 @@
 pub mod assembler;
 pub mod decoder;
 pub mod packet;
-pub mod revolution;
+/// The revolution type, shared by every model (it lives in [`crate::lidar::revolution`]).
+pub mod revolution {
+    pub use crate::lidar::revolution::*;
+}
 
+pub use crate::lidar::revolution::{Reading, Revolution, bin_angle_rad, raw_to_bin};
+use crate::lidar::{LidarFaults, LidarModel, LidarStream};
 pub use assembler::{Assembler, AssemblerConfig, AssemblerStats};
 pub use decoder::{ChecksumPolicy, Decoded, Decoder, DecoderStats};
 pub use packet::{
     PACKET_LEN, PACKETS_PER_REV, Packet, READINGS_PER_PACKET, READINGS_PER_REV, RawReading, Repr,
     SYNC_BYTE,
 };
-pub use revolution::{Reading, Revolution, bin_angle_rad, raw_to_bin};
 
 /// Serial link settings of the LDS-01 (`hardware.md`).
 pub mod link {
@@ -67,25 +74,8 @@ pub struct Lds01Config {
     pub assembler: AssemblerConfig,
 }
 
-/// Every LDS-01 fault counter in one place (cumulative since start).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
-#[cfg_attr(feature = "defmt", derive(defmt::Format))]
-pub struct Lds01Faults {
-    /// Bytes that were not part of any packet passed on.
-    pub bytes_skipped: u64,
-    /// Packets whose checksum failed (dropped under `Verify`, kept under `Count`).
-    pub bad_checksum: u64,
-    /// Sync bytes followed by an out-of-range index.
-    pub bad_index: u64,
-    /// Packets missing from revolutions handed out.
-    pub missing_packets: u64,
-    /// Packets received twice in a row.
-    pub repeated_packets: u64,
-    /// Bad-checksum packets kept by the `Count` policy but dropped for an out-of-sequence index.
-    pub out_of_sequence_bad_packets: u64,
-    /// Revolutions handed out with packets missing.
-    pub incomplete_revolutions: u64,
-}
+/// The LDS-01's fault counters: the shared set ([`LidarFaults`]).
+pub type Lds01Faults = LidarFaults;
 
 /// Decoder and assembler glued together: feed bytes, get revolutions.
 #[derive(Debug, Clone)]
@@ -103,58 +93,6 @@ impl Lds01Stream {
         }
     }
 
-    /// Feeds a chunk of bytes; calls `on_revolution` for each revolution it finishes and
-    /// returns how many. `host_us` is the host's monotonic clock for this chunk, if any.
-    pub fn feed(
-        &mut self,
-        bytes: &[u8],
-        host_us: Option<u64>,
-        mut on_revolution: impl FnMut(&Revolution),
-    ) -> usize {
-        let mut done = 0;
-        let mut input = bytes;
-        while self.next_revolution(&mut input, host_us) {
-            if let Some(rev) = self.assembler.last() {
-                on_revolution(rev);
-                done += 1;
-            }
-        }
-        done
-    }
-
-    /// Consumes bytes from the front of `input` until a revolution is finished (returns
-    /// `true`; read it with [`Lds01Stream::last_revolution`]) or `input` is used up (`false`).
-    /// This form lets a caller look at the stream's counters between revolutions.
-    pub fn next_revolution(&mut self, input: &mut &[u8], host_us: Option<u64>) -> bool {
-        while let Some(packet) = self.decoder.next_packet(input) {
-            if self.assembler.push_packet(&packet, host_us) {
-                return true;
-            }
-        }
-        false
-    }
-
-    /// The last revolution finished.
-    pub fn last_revolution(&self) -> Option<&Revolution> {
-        self.assembler.last()
-    }
-
-    /// Hands out a partial revolution if no packet arrived for the stale time.
-    pub fn poll(&mut self, now_us: u64, on_revolution: impl FnOnce(&Revolution)) -> bool {
-        self.assembler.poll(now_us).map(on_revolution).is_some()
-    }
-
-    /// End of stream: drops a partial packet and hands out a partial revolution.
-    pub fn finish(&mut self, on_revolution: impl FnOnce(&Revolution)) -> bool {
-        self.decoder.reset();
-        self.assembler.flush().map(on_revolution).is_some()
-    }
-
-    /// The link was lost and reopened: a partial packet cannot continue.
-    pub fn link_reset(&mut self) {
-        self.decoder.reset();
-    }
-
     /// The decoder (its counters, its policy).
     pub fn decoder(&self) -> &Decoder {
         &self.decoder
@@ -164,17 +102,48 @@ impl Lds01Stream {
     pub fn assembler(&self) -> &Assembler {
         &self.assembler
     }
+}
+
+impl LidarStream for Lds01Stream {
+    fn model(&self) -> LidarModel {
+        LidarModel::Lds01
+    }
+
+    fn next_revolution(&mut self, input: &mut &[u8], host_us: Option<u64>) -> bool {
+        while let Some(packet) = self.decoder.next_packet(input) {
+            if self.assembler.push_packet(&packet, host_us) {
+                return true;
+            }
+        }
+        false
+    }
+
+    fn last_revolution(&self) -> Option<&Revolution> {
+        self.assembler.last()
+    }
+
+    fn poll(&mut self, now_us: u64) -> Option<&Revolution> {
+        self.assembler.poll(now_us)
+    }
+
+    fn finish(&mut self) -> Option<&Revolution> {
+        self.decoder.reset();
+        self.assembler.flush()
+    }
+
+    fn link_reset(&mut self) {
+        self.decoder.reset();
+    }
 
     /// Sensor-clock time of the latest packet slot's end, seconds.
-    pub fn sensor_time_s(&self) -> f64 {
+    fn sensor_time_s(&self) -> f64 {
         self.assembler.sensor_time_s()
     }
 
-    /// All fault counters.
-    pub fn faults(&self) -> Lds01Faults {
+    fn faults(&self) -> LidarFaults {
         let d = self.decoder.stats();
         let a = self.assembler.stats();
-        Lds01Faults {
+        LidarFaults {
             bytes_skipped: d.bytes_skipped,
             bad_checksum: d.bad_checksum,
             bad_index: d.bad_index,
@@ -182,22 +151,25 @@ impl Lds01Stream {
             repeated_packets: a.repeated_packets,
             out_of_sequence_bad_packets: a.out_of_sequence_bad_packets,
             incomplete_revolutions: a.incomplete_revolutions,
+            ..LidarFaults::default()
         }
     }
 }
 
 /// Reads once from any `embedded_io::Read` into `buf` and feeds what came into `stream`.
 /// Returns the bytes read (0 = end of stream, after which the partial revolution is flushed).
-pub fn read_and_feed<R: embedded_io::Read>(
+pub fn read_and_feed<R: embedded_io::Read, S: LidarStream>(
     io: &mut R,
     buf: &mut [u8],
-    stream: &mut Lds01Stream,
+    stream: &mut S,
     host_us: Option<u64>,
     mut on_revolution: impl FnMut(&Revolution),
 ) -> Result<usize, R::Error> {
     let n = io.read(buf)?;
     if n == 0 {
-        stream.finish(on_revolution);
+        if let Some(rev) = stream.finish() {
+            on_revolution(rev);
+        }
     } else {
         stream.feed(&buf[..n.min(buf.len())], host_us, &mut on_revolution);
     }

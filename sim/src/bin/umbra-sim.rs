@@ -4,7 +4,7 @@
 //!   writes the datasets of `sim::dataset` with a progress bar.
 //! * `umbra-sim speed [--scenarios 16] [--frames 200]` measures labelled frames per second
 //!   with rasters and labels built in memory.
-//! * `umbra-sim capture --out FILE [--revolutions N] [--seed S] [--corrupt]` writes raw LDS-01
+//! * `umbra-sim capture --out FILE [--revolutions N] [--seed S] [--corrupt] [--model M]` writes raw LiDAR
 //!   bytes as a serial port delivers them (for `umbra replay`).
 //! * `umbra-sim picture --out FILE [--seed S] [--tour]` draws a scene.
 
@@ -16,7 +16,7 @@ use clap::{Parser, Subcommand, ValueEnum};
 use indicatif::{ProgressBar, ProgressStyle};
 use sim::corrupt::{Corruption, corrupt};
 use sim::dataset::{DatasetConfig, generate, in_memory, simulate};
-use sim::lds01::{Lds01Sim, Lds01SimConfig};
+use sim::lds01::Lds01SimConfig;
 use sim::world::{RoomKind, World, WorldConfig};
 
 #[derive(Parser)]
@@ -104,6 +104,10 @@ enum Command {
         /// Send the bytes through a noisy line (1e-3 bit flips, inserted/dropped bytes, bursts).
         #[arg(long)]
         corrupt: bool,
+        /// The LiDAR model whose bytes to write: lds01, lds02, ld06, ld19, rplidar-a1,
+        /// rplidar-a2 (the same scene for each).
+        #[arg(long, default_value = "lds01")]
+        model: String,
     },
     /// Heading/position drift of odometry, compass overwrite and fusion (Markdown table).
     PoseEval {
@@ -238,16 +242,23 @@ fn run(command: Command) -> Result<(), String> {
             seed,
             room_seed,
             corrupt: noisy,
+            model,
         } => {
-            let mut sim = Lds01Sim::new(
-                World::random_room(room_seed),
-                Lds01SimConfig::default(),
-                seed,
-            );
+            let model = drivers::lidar::LidarModel::ALL
+                .into_iter()
+                .find(|m| m.cli_name() == model)
+                .ok_or_else(|| format!("--model {model}: not a LiDAR model umbra knows"))?;
+            let sc = sim::scenario::ScenarioConfig {
+                lidar: Lds01SimConfig::default(),
+                ..sim::scenario::ScenarioConfig::default()
+            };
+            let scenario =
+                sim::scenario::Scenario::in_world(World::random_room(room_seed), seed, &sc);
+            let mut sim = sim::wire::WireSim::new(scenario, model);
             let mut bytes = Vec::new();
             sim.emit_revolutions(revolutions, &mut bytes);
             if noisy {
-                bytes = corrupt(bytes.chunks(42), Corruption::ISSUE_MIX, seed).bytes;
+                bytes = corrupt(bytes.chunks(sim.unit_len()), Corruption::ISSUE_MIX, seed).bytes;
             }
             std::fs::write(&out, &bytes)
                 .map_err(|e| format!("cannot write {}: {e}", out.display()))?;

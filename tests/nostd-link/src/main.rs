@@ -7,6 +7,7 @@ use core::hint::black_box;
 use core::panic::PanicInfo;
 
 use drivers::lds01::{Lds01Config, Lds01Stream, PACKET_LEN, RawReading, Repr};
+use drivers::lidar::LidarStream as _;
 use perception::geometry::{Point2, Pose2};
 
 /// Entry point: decode one emitted revolution and transform its points.

@@ -1,30 +1,50 @@
-//! One LiDAR revolution: 360 readings in our angle convention, with time stamps.
+//! One LiDAR revolution, the same type for every model: 360 bins in our angle convention,
+//! with time stamps.
 //!
 //! ## Angle convention
 //!
 //! Angles follow ROS REP 103: radians, **counter-clockwise** from the LiDAR's forward axis
-//! (x forward, y left, seen from above). The LDS-01 sends its readings **clockwise**: raw
-//! reading number `i = 6·k + j` (packet `k`, reading `j`) lies at `(359 − i)°`. This is the
-//! mapping of the vendor's ROS driver (`ranges[359 − i]` with `angle_min = 0`, +1° per step),
-//! which every TurtleBot3 map made with that driver relies on. So:
+//! (x forward, y left, seen from above). Bin `d` holds the reading closest to `d` degrees
+//! counter-clockwise, `d = 0..360`: [0°, 360°), no duplicate end, **the same count for every
+//! model and every revolution** whatever the sensor's native beam count (the complaint of
+//! `lidars.md` §1d.3 cannot happen). Every model we support sweeps **clockwise**; each family
+//! maps its raw angle into this convention once, in its own module:
 //!
-//! * `readings[d]` is the reading at `d` degrees counter-clockwise, `d = 0..360`;
-//! * raw reading `i` is stored at `d = 359 − i` ([`raw_to_bin`]); raw 0 is at 359° (1° to the
-//!   right of forward), raw 89 at 270° (straight right), raw 269 at 90° (straight left),
-//!   raw 359 at 0° (straight ahead).
+//! * LDS-01: raw reading `i = 6·k + j` (packet `k`, reading `j`) lies at `(359 − i)°`, the
+//!   mapping of the vendor's ROS driver (`ranges[359 − i]`), which every TurtleBot3 map made
+//!   with that driver relies on ([`raw_to_bin`]);
+//! * LDROBOT (LDS-02/LD08, LD06, LD19): raw angle θ → `(360 − θ)°` (the vendor drivers'
+//!   right-hand conversion), plus the LD08 geometry correction;
+//! * RPLIDAR A1/A2: raw angle θ → `(180 − θ)°` (the vendor ROS driver's `π − θ`).
 //!
 //! The LiDAR frame is not the robot frame: on a TurtleBot3 Burger the LiDAR sits at
 //! x = −0.032 m, unrotated. Moving points into the robot frame is the pose code's job.
 //!
+//! ## Sectors
+//!
+//! Coverage is kept in 60 **sectors** of 6° in sweep order: sector `k` holds the bins swept
+//! from `6k/360` to `6(k+1)/360` of the revolution after [`Revolution::sweep_start_bin`]. For
+//! the LDS-01 a sector is exactly one packet; for the other models a sector is present when any
+//! point landed in it, and a sector the sweep passed without data is a missing one.
+//!
 //! ## Time stamps
 //!
 //! [`Revolution::t_start_s`] is on the sensor's own clock (`interfaces.md` §2): the start of
-//! packet slot 0, with a slot lasting `1/rpm` seconds. Raw reading `i` was taken at
-//! `t_start_s + i/360 · period_s` ([`Revolution::reading_time_s`]), so a moving robot's scan
-//! can be de-skewed. [`Revolution::host_time_us`] is the host's monotonic clock when the
-//! first packet of the revolution was decoded, when the caller supplied one.
+//! the sweep (for the LDS-01, the start of packet slot 0). The bin swept `f` of the way round
+//! was taken at `t_start_s + f · period_s` ([`Revolution::reading_time_s`]), so a moving robot's
+//! scan can be de-skewed; the frame's stamp is the first ray's time
+//! ([`Revolution::first_ray_time_s`]), never the publish time. [`Revolution::host_time_us`] is
+//! the host's monotonic clock when the first data of the revolution was decoded, when the
+//! caller supplied one.
 
-use super::packet::{PACKETS_PER_REV, READINGS_PER_REV};
+/// Bins per revolution, for every model.
+pub const BINS: usize = 360;
+/// Sectors per revolution (6° each; an LDS-01 packet).
+pub const SECTORS: usize = 60;
+/// Bins per sector.
+pub const BINS_PER_SECTOR: usize = BINS / SECTORS;
+const READINGS_PER_REV: usize = BINS;
+const PACKETS_PER_REV: usize = SECTORS;
 
 /// One reading in our convention.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
@@ -40,8 +60,9 @@ pub struct Reading {
     pub valid: bool,
 }
 
-/// The raw reading number `i` (0..360, clockwise) → the bin `d` (degrees counter-clockwise).
-/// Values outside 0..360 are taken modulo 360.
+/// LDS-01: the raw reading number `i` (0..360, clockwise) → the bin `d` (degrees
+/// counter-clockwise). Values outside 0..360 are taken modulo 360. The mapping is its own
+/// inverse.
 #[inline]
 pub const fn raw_to_bin(i: usize) -> usize {
     (READINGS_PER_REV - 1) - (i % READINGS_PER_REV)
@@ -67,12 +88,14 @@ pub struct Revolution {
     pub rpm: f32,
     /// Host clock (caller's monotonic µs) when the first packet received was decoded.
     pub host_time_us: Option<u64>,
-    /// Packets received (60 = complete).
+    /// Sectors received (60 = complete; for the LDS-01, its packets).
     pub packets: u8,
-    /// Bit `k` set if packet `k` was received.
+    /// Bit `k` set if sector `k` (sweep order) was received.
     pub present: u64,
-    /// Packets received with a failed checksum (only under the `Count` policy).
+    /// Packets received with a failed checksum (only under the LDS-01's `Count` policy).
     pub bad_checksum_packets: u8,
+    /// The bin the sweep starts at (LDS-01: 359); sweep order runs clockwise from it.
+    pub sweep_start_bin: u16,
     /// Readings by bin: `readings[d]` is at `d` degrees counter-clockwise.
     pub readings: [Reading; READINGS_PER_REV],
 }
@@ -108,28 +131,40 @@ impl Revolution {
             packets: 0,
             present: 0,
             bad_checksum_packets: 0,
+            sweep_start_bin: (READINGS_PER_REV - 1) as u16,
             readings,
         }
     }
 
-    /// `true` if all 60 packets arrived.
+    /// `true` if all 60 sectors arrived.
     pub fn is_complete(&self) -> bool {
         usize::from(self.packets) == PACKETS_PER_REV
     }
 
-    /// Packets that did not arrive.
+    /// Sectors that did not arrive.
     pub fn missing_packets(&self) -> u8 {
         PACKETS_PER_REV as u8 - self.packets
     }
 
-    /// `true` if packet `k` (0..60) arrived.
+    /// `true` if sector `k` (0..60, sweep order) arrived.
     pub fn has_packet(&self, k: usize) -> bool {
         k < PACKETS_PER_REV && self.present & (1 << k) != 0
     }
 
+    /// Position of bin `d` in sweep order, 0..360 (0 = the first bin swept).
+    pub fn sweep_position(&self, d: usize) -> usize {
+        let start = usize::from(self.sweep_start_bin) % READINGS_PER_REV;
+        (start + READINGS_PER_REV - d % READINGS_PER_REV) % READINGS_PER_REV
+    }
+
+    /// The sector (sweep order) bin `d` belongs to.
+    pub fn sector_of(&self, d: usize) -> usize {
+        self.sweep_position(d) / BINS_PER_SECTOR
+    }
+
     /// Sensor-clock time (s) at which the reading of bin `d` was taken.
     pub fn reading_time_s(&self, d: usize) -> f64 {
-        let i = raw_to_bin(d); // the mapping is its own inverse
+        let i = self.sweep_position(d);
         self.t_start_s + (i as f64 / READINGS_PER_REV as f64) * f64::from(self.period_s)
     }
 
@@ -149,12 +184,10 @@ impl Revolution {
         self.readings.iter().filter(|r| r.valid).count()
     }
 
-    /// Readings with a range of exactly 0 (no return) among the packets received.
+    /// Readings with a range of exactly 0 (no return) among the sectors received.
     pub fn no_return_count(&self) -> usize {
-        (0..PACKETS_PER_REV)
-            .filter(|&k| self.has_packet(k))
-            .flat_map(|k| (0..6).map(move |j| raw_to_bin(6 * k + j)))
-            .filter(|&d| self.readings[d].range_m == 0.0)
+        (0..READINGS_PER_REV)
+            .filter(|&d| self.has_packet(self.sector_of(d)) && self.readings[d].range_m == 0.0)
             .count()
     }
 
@@ -196,6 +229,22 @@ mod test {
         assert!((r.readings[90].angle_rad - core::f32::consts::FRAC_PI_2).abs() < 1e-6);
         assert!(r.range_stats().is_none());
         assert_eq!(r.missing_packets(), 60);
+    }
+
+    #[test]
+    fn sectors_follow_the_sweep() {
+        let mut r = Revolution::empty();
+        // LDS-01: sector k = packet k = raw readings 6k..6k+6 = bins 359-6k down to 354-6k.
+        for i in 0..360 {
+            assert_eq!(r.sector_of(raw_to_bin(i)), i / 6);
+        }
+        // A sweep starting at bin 0 (LDROBOT): 0, 359, 358, ...
+        r.sweep_start_bin = 0;
+        assert_eq!(r.sweep_position(0), 0);
+        assert_eq!(r.sweep_position(359), 1);
+        assert_eq!(r.sector_of(355), 0);
+        assert_eq!(r.sector_of(354), 1);
+        assert_eq!(r.sector_of(1), 59);
     }
 
     #[test]
