@@ -126,6 +126,14 @@ impl LidarSource {
                 det.feed(&head);
                 let verdict = det.verdict();
                 let words = drivers::probe::describe(&verdict);
+                if let Verdict::Found { model, .. } | Verdict::HighErrorRate { model, .. } = verdict
+                    && model.family() == drivers::lidar::Family::Rplidar
+                {
+                    log::warn!(
+                        "capture {}: an RPLIDAR A1 and A2 send the same bytes and nodes carry no time; the clock assumes the A1's 2 kHz (name --lidar-model rplidar-a2 for an A2)",
+                        path.display()
+                    );
+                }
                 match verdict {
                     Verdict::Found { model, .. } => (model, format!("recognised: {words}")),
                     Verdict::HighErrorRate { model, .. } => {

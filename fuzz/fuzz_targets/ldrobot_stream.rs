@@ -30,7 +30,11 @@ fuzz_target!(|data: &[u8]| {
             assert!(rev.packets as usize <= 60);
             assert_eq!(rev.packets as u32, rev.present.count_ones());
             assert!(rev.t_start_s.is_finite() && rev.period_s.is_finite() && rev.period_s > 0.0);
-            assert!(rev.readings.iter().all(|r| r.range_m.is_finite() && r.range_m >= 0.0));
+            assert!(
+                rev.readings
+                    .iter()
+                    .all(|r| r.range_m.is_finite() && r.range_m >= 0.0)
+            );
         });
         let _ = stream.poll(host_us);
     }

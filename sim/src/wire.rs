@@ -22,7 +22,8 @@ use crate::scenario::{Frame, OdomSample, Scenario};
 /// The LD08 correction's angle shift far out, degrees (`atan 0.11923`).
 const LD08_FAR_SHIFT_DEG: f32 = 6.8;
 
-/// Beams a turn of `model` at `period_s` (LDROBOT: a whole number of 12-point frames).
+/// Beams a turn of `model` at `period_s` (LDROBOT: a whole number of 12-point frames, rounded
+/// down).
 pub fn beams_per_revolution(model: LidarModel, period_s: f64) -> usize {
     let n = (f64::from(model.sample_rate_hz()) * period_s)
         .round()

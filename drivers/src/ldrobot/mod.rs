@@ -24,7 +24,8 @@
 //! ## Sensor clock (`interfaces.md` §2)
 //!
 //! t = 0 at the first valid frame; each frame's millisecond timestamp (wrapping at 30000)
-//! advances the clock by its difference to the previous one; point `i` of a frame lies
+//! advances the clock by its difference to the previous one (a stamp behind the previous one
+//! by less than half the wrap holds the clock, counted); point `i` of a frame lies
 //! `i / sample_rate` after the frame's stamp.
 
 pub mod decoder;
@@ -92,6 +93,8 @@ pub struct LdrobotStats {
     pub health_errors: u64,
     /// The last health error code seen (0 = none).
     pub last_health_error: u8,
+    /// Frame stamps behind the previous one (held, not read as a wrap).
+    pub stamp_steps_back: u64,
 }
 
 /// Decoder + point assembler for an LDROBOT LiDAR; see the module docs.
@@ -175,7 +178,15 @@ impl LdrobotStream {
             Some((t, ts)) => {
                 let wrap = u32::from(frame::TIMESTAMP_WRAP_MS);
                 let (now, prev) = (u32::from(f.timestamp_ms) % wrap, u32::from(ts) % wrap);
-                t + f64::from((now + wrap - prev) % wrap) / 1000.0
+                let step = (now + wrap - prev) % wrap;
+                // A stamp a little behind the last one is jitter, not a 30 s wrap: the clock
+                // never runs backwards, so it stands still.
+                if step > wrap / 2 {
+                    self.stats.stamp_steps_back += 1;
+                    t
+                } else {
+                    t + f64::from(step) / 1000.0
+                }
             }
         };
         self.clock = Some((t_frame, f.timestamp_ms));

@@ -117,17 +117,18 @@ impl Decoder {
     pub fn next_item(&mut self, input: &mut &[u8]) -> Option<Decoded> {
         loop {
             // Fast path: nodes straight from the input.
-            if self.len == 0 && self.reply.is_none() && self.hunted == 0 {
-                if let Some(b) = input.get(..NODE_LEN)
-                    && !(b[0] == SYNC && b[1] == SYNC2)
-                    && let Ok(node) = Node::parse(b)
-                {
-                    self.stats.bytes_in += NODE_LEN as u64;
-                    self.stats.nodes += 1;
-                    self.track(node.angle_q6);
-                    *input = &input[NODE_LEN..];
-                    return Some(Decoded::Node(node));
-                }
+            if self.len == 0
+                && self.reply.is_none()
+                && self.hunted == 0
+                && let Some(b) = input.get(..NODE_LEN)
+                && !(b[0] == SYNC && b[1] == SYNC2)
+                && let Ok(node) = Node::parse(b)
+            {
+                self.stats.bytes_in += NODE_LEN as u64;
+                self.stats.nodes += 1;
+                self.track(node.angle_q6);
+                *input = &input[NODE_LEN..];
+                return Some(Decoded::Node(node));
             }
             if self.reply.is_none() && self.len < 2 {
                 // Two bytes tell a descriptor from a node.

@@ -7,8 +7,8 @@
 //! | byte | bits                                               |
 //! |------|----------------------------------------------------|
 //! | 0    | bit 0 S (new 360° scan), bit 1 !S, bits 2–7 quality |
-//! | 1    | bit 0 C (check, always 1), bits 1–7 angle_q6[6:0]   |
-//! | 2    | angle_q6[14:7]                                     |
+//! | 1    | bit 0 C (check, always 1), bits 1–7 angle_q6 bits 6–0   |
+//! | 2    | angle_q6 bits 14–7                                 |
 //! | 3–4  | distance_q2 (u16 LE; mm = value / 4; 0 = no return) |
 
 /// Request start byte.

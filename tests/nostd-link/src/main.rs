@@ -7,7 +7,8 @@ use core::hint::black_box;
 use core::panic::PanicInfo;
 
 use drivers::lds01::{Lds01Config, Lds01Stream, PACKET_LEN, RawReading, Repr};
-use drivers::lidar::LidarStream as _;
+use drivers::lidar::detect::Detector;
+use drivers::lidar::{AnyLidar, LidarConfig, LidarModel, LidarStream as _};
 use perception::geometry::{Point2, Pose2};
 
 /// Entry point: decode one emitted revolution and transform its points.
@@ -38,6 +39,17 @@ pub extern "C" fn _start() -> ! {
     }
     black_box(acc);
     black_box(stream.faults());
+    // Every other model's stream and the detector, on the same bytes.
+    let mut detector = Detector::new();
+    detector.feed(black_box(&packet));
+    black_box(detector.verdict());
+    for model in LidarModel::ALL {
+        let mut any = AnyLidar::new(model, &LidarConfig::default());
+        any.feed(black_box(&packet), None, |rev| {
+            black_box(rev.valid_count());
+        });
+        black_box(any.finish().map(|r| r.packets));
+    }
     loop {}
 }
 
