@@ -138,7 +138,7 @@ proptest! {
             host += 5_000;
             s.feed(c, Some(host), |r| {
                 if r.packets > 60 || r.present.count_ones() != u32::from(r.packets)
-                    || !r.t_start_s.is_finite() || !(r.period_s > 0.0)
+                    || !r.t_start_s.is_finite() || r.period_s.is_nan() || r.period_s <= 0.0
                     || r.readings.iter().any(|x| !x.range_m.is_finite())
                 {
                     bad = Some(r.seq);
