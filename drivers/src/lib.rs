@@ -36,6 +36,7 @@
 #[cfg(feature = "compass")]
 pub mod compass;
 pub mod dynamixel;
+mod framing;
 pub mod ldrobot;
 pub mod lds01;
 pub mod lidar;

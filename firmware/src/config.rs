@@ -578,10 +578,10 @@ impl Config {
         }
     }
 
-    /// The LiDAR stream settings for `model`: the `[lidar]` range window applies to every
-    /// model (it is the pipeline's working range, which Method A's thresholds and Method B's
-    /// training data assume), the checksum policy to the LDS-01 only.
-    pub fn lidar(&self, _model: drivers::lidar::LidarModel) -> drivers::lidar::LidarConfig {
+    /// The LiDAR stream settings, the same for every model: the `[lidar]` range window is the
+    /// pipeline's working range (which Method A's thresholds and Method B's training data
+    /// assume), and the checksum policy only concerns the LDS-01.
+    pub fn lidar(&self) -> drivers::lidar::LidarConfig {
         let l = self.lds01();
         drivers::lidar::LidarConfig {
             min_range_m: Some(l.assembler.min_range_m),

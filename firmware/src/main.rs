@@ -376,7 +376,7 @@ fn run_loop(
         viz,
         snapshot: common.snapshot.clone(),
     };
-    let stream = drivers::lidar::AnyLidar::new(source.model(), &cfg.lidar(source.model()));
+    let stream = drivers::lidar::AnyLidar::new(source.model(), &cfg.lidar());
     let summary = runner::run(source, stream, opts)
         .map_err(|e| (EXIT_FAULT, format!("cannot write output: {e}")))?;
     print_summary(&summary);

@@ -111,17 +111,19 @@ impl LidarSource {
     /// Opens a raw capture file of `model`, or (`None`) recognises the model from its first
     /// [`DETECT_BYTES`] bytes. A file in which no model's frames are found is an error.
     pub fn capture(path: &Path, model: Option<LidarModel>) -> Result<(Self, String), String> {
-        let open =
-            || File::open(path).map_err(|e| format!("cannot open capture {}: {e}", path.display()));
+        use std::io::{Read as _, Seek as _};
+        let mut file =
+            File::open(path).map_err(|e| format!("cannot open capture {}: {e}", path.display()))?;
         let (model, how) = match model {
             Some(m) => (m, format!("{m} named")),
             None => {
+                // Read the head, then rewind: the run decodes the capture from its first byte.
                 let mut head = Vec::with_capacity(DETECT_BYTES);
-                std::io::Read::read_to_end(
-                    &mut std::io::Read::take(open()?, DETECT_BYTES as u64),
-                    &mut head,
-                )
-                .map_err(|e| format!("cannot read capture {}: {e}", path.display()))?;
+                (&mut file)
+                    .take(DETECT_BYTES as u64)
+                    .read_to_end(&mut head)
+                    .and_then(|_| file.rewind())
+                    .map_err(|e| format!("cannot read capture {}: {e}", path.display()))?;
                 let mut det = Detector::new();
                 det.feed(&head);
                 let verdict = det.verdict();
@@ -138,7 +140,7 @@ impl LidarSource {
                     Verdict::Found { model, .. } => (model, format!("recognised: {words}")),
                     Verdict::HighErrorRate { model, .. } => {
                         log::warn!("capture {}: {words}", path.display());
-                        (model, format!("recognised despite errors: {words}"))
+                        (model, format!("{model} recognised despite errors"))
                     }
                     _ => {
                         return Err(format!(
@@ -153,7 +155,7 @@ impl LidarSource {
         Ok((
             LidarSource::Capture {
                 path: path.to_owned(),
-                file: FromStd::new(open()?),
+                file: FromStd::new(file),
                 model,
             },
             how,

@@ -56,14 +56,15 @@ pub fn emit_ldrobot(model: LidarModel, frame: &Frame, out: &mut Vec<u8>) {
             speed_dps,
             ..FrameRepr::default()
         };
-        // Raw angles on the frame's 0.01° grid, so the driver's interpolation gives them back.
+        // Raw angles on the frame's 0.01° grid, and each point aimed at the angle the driver's
+        // interpolation will give it.
         let first = 12 * f;
         let start_c = ((36_000 * first) / n) as u32 % 36_000;
         let end_c = ((36_000 * (first + POINTS - 1)) / n) as u32 % 36_000;
         repr.start_angle_cdeg = start_c as u16;
         repr.end_angle_cdeg = end_c as u16;
-        for (i, p) in repr.points.iter_mut().enumerate() {
-            let raw = repr_angle(start_c, end_c, i);
+        let raw_angles: [f32; POINTS] = core::array::from_fn(|i| repr.point_angle_deg(i));
+        for (p, &raw) in repr.points.iter_mut().zip(&raw_angles) {
             let (mut mm, mut intensity) = reading_at(frame, 360.0 - raw);
             let mut raw_mm = f32::from(mm);
             if ld08 {
@@ -105,16 +106,6 @@ pub fn emit_ldrobot(model: LidarModel, frame: &Frame, out: &mut Vec<u8>) {
         let _ = repr.emit_into(&mut buf);
         out.extend_from_slice(&buf);
     }
-}
-
-/// The driver's in-frame angle rule (integer step), for the emitter to aim with.
-fn repr_angle(start_c: u32, end_c: u32, i: usize) -> f32 {
-    FrameRepr {
-        start_angle_cdeg: start_c as u16,
-        end_angle_cdeg: end_c as u16,
-        ..FrameRepr::default()
-    }
-    .point_angle_deg(i)
 }
 
 /// Appends one revolution of `frame` as RPLIDAR SCAN nodes to `out`.

@@ -79,8 +79,7 @@ fn per_frame_with(method_b: bool, viz: Option<runner::VizLink>) -> Vec<u64> {
         snapshot: None,
     };
     let mut summary = None;
-    let model = source.model();
-    let stream = drivers::lidar::AnyLidar::new(model, &cfg.lidar(model));
+    let stream = drivers::lidar::AnyLidar::new(source.model(), &cfg.lidar());
     counted(|| summary = Some(runner::run(&mut source, stream, opts).expect("run")));
     let summary = summary.unwrap();
     assert_eq!(summary.frames, FRAMES);

@@ -19,6 +19,7 @@
 //! buffered()`, checked by the tests on random streams.
 
 use super::frame::{self, FRAME_LEN, FrameRepr, HEADER, Health};
+use crate::framing::{Candidate, skip_to};
 
 /// Bytes the decoder buffers: the longest frame.
 pub const DECODER_BUFFER_LEN: usize = FRAME_LEN;
@@ -54,21 +55,10 @@ pub struct DecoderStats {
 }
 
 /// The decoder; see the module docs.
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, Default)]
 pub struct Decoder {
-    buf: [u8; DECODER_BUFFER_LEN],
-    len: usize,
+    cand: Candidate<DECODER_BUFFER_LEN>,
     stats: DecoderStats,
-}
-
-impl Default for Decoder {
-    fn default() -> Self {
-        Decoder {
-            buf: [0; DECODER_BUFFER_LEN],
-            len: 0,
-            stats: DecoderStats::default(),
-        }
-    }
 }
 
 impl Decoder {
@@ -84,32 +74,24 @@ impl Decoder {
 
     /// Bytes held in the buffer (a partial frame).
     pub fn buffered(&self) -> usize {
-        self.len
+        self.cand.len()
     }
 
     /// Drops a partial frame (link reset, end of stream), counting its bytes as skipped.
     pub fn reset(&mut self) {
-        self.stats.bytes_skipped += self.len as u64;
-        self.len = 0;
+        self.stats.bytes_skipped += self.cand.clear() as u64;
     }
 
     /// Takes bytes from the front of `input` until one frame is complete and returns it;
     /// `None` once `input` is used up.
     pub fn next_frame(&mut self, input: &mut &[u8]) -> Option<Decoded> {
         loop {
-            if self.len == 0 {
-                match input.iter().position(|&b| b == HEADER) {
-                    Some(p) => {
-                        self.stats.bytes_in += p as u64;
-                        self.stats.bytes_skipped += p as u64;
-                        *input = &input[p..];
-                    }
-                    None => {
-                        self.stats.bytes_in += input.len() as u64;
-                        self.stats.bytes_skipped += input.len() as u64;
-                        *input = &[];
-                        return None;
-                    }
+            if self.cand.len() == 0 {
+                let skipped = skip_to(input, HEADER) as u64;
+                self.stats.bytes_in += skipped;
+                self.stats.bytes_skipped += skipped;
+                if input.is_empty() {
+                    return None;
                 }
                 // Fast path: a whole good measurement frame in the input, parsed in place.
                 if let Some(candidate) = input.get(..FRAME_LEN)
@@ -124,8 +106,8 @@ impl Decoder {
                 }
             }
             // The type byte fixes the length; until it is here, want 2 bytes.
-            let want = if self.len >= 2 {
-                match frame::frame_len(self.buf[1]) {
+            let want = if let Some(&info) = self.cand.bytes().get(1) {
+                match frame::frame_len(info) {
                     Some(n) => n,
                     None => {
                         self.stats.bad_type += 1;
@@ -137,19 +119,15 @@ impl Decoder {
                 2
             };
             // After a resync the buffer may already hold more than a short (health) frame.
-            let take = want.saturating_sub(self.len).min(input.len());
-            self.buf[self.len..self.len + take].copy_from_slice(&input[..take]);
-            self.len += take;
-            self.stats.bytes_in += take as u64;
-            *input = &input[take..];
-            if self.len < want {
+            self.stats.bytes_in += self.cand.fill(input, want) as u64;
+            if self.cand.len() < want {
                 return None; // input used up
             }
             if want == 2 {
                 continue;
             }
             // Bytes buffered past this candidate (only after a resync) stay for the next one.
-            let body = &self.buf[..want];
+            let body = &self.cand.bytes()[..want];
             if !frame::crc_ok(body) {
                 self.stats.bad_crc += 1;
                 self.resync();
@@ -172,36 +150,15 @@ impl Decoder {
                     Decoded::Info
                 }
             };
-            self.consume(want);
+            self.cand.consume(want);
             return Some(out);
         }
-    }
-
-    /// Removes a frame of `n` bytes from the front of the buffer, keeping what follows it.
-    fn consume(&mut self, n: usize) {
-        let n = n.min(self.len);
-        self.buf.copy_within(n..self.len, 0);
-        self.len -= n;
     }
 
     /// Rejects the candidate at the front of the buffer: drops its header byte and everything
     /// up to the next `0x54` already buffered.
     fn resync(&mut self) {
-        let next = self.buf[1..self.len]
-            .iter()
-            .position(|&b| b == HEADER)
-            .map(|p| p + 1);
-        match next {
-            Some(start) => {
-                self.buf.copy_within(start..self.len, 0);
-                self.len -= start;
-                self.stats.bytes_skipped += start as u64;
-            }
-            None => {
-                self.stats.bytes_skipped += self.len as u64;
-                self.len = 0;
-            }
-        }
+        self.stats.bytes_skipped += self.cand.resync(HEADER) as u64;
     }
 }
 

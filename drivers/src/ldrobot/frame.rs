@@ -201,13 +201,24 @@ impl FrameRepr {
     /// `(end + 36000 − start) mod 36000` centidegrees, divided by 11 **in integers** (as the C
     /// code does), then `start + i·step`, wrapped into [0, 360).
     pub fn point_angle_deg(&self, i: usize) -> f32 {
-        let start = u32::from(self.start_angle_cdeg);
-        let end = u32::from(self.end_angle_cdeg);
-        let diff = (end + 36_000 - start % 36_000) % 36_000;
-        let step = (diff / (POINTS as u32 - 1)) as f32 / 100.0;
-        let a = start as f32 / 100.0 + i as f32 * step;
+        let step = (self.span_cdeg() / (POINTS as u32 - 1)) as f32 / 100.0;
+        let a = f32::from(self.start_angle_cdeg) / 100.0 + i as f32 * step;
         let a = a % 360.0;
         if a < 0.0 { a + 360.0 } else { a }
+    }
+
+    /// First to last point, clockwise, 0.01°: `(end + 36000 − start) mod 36000`.
+    pub fn span_cdeg(&self) -> u32 {
+        let start = u32::from(self.start_angle_cdeg);
+        let end = u32::from(self.end_angle_cdeg);
+        (end + 36_000 - start % 36_000) % 36_000
+    }
+
+    /// The sample rate the frame implies, Hz: speed ÷ angular step between points (2300 for
+    /// an LD08, 4500 for an LD06/LD19). `None` for a zero speed or span.
+    pub fn sample_rate_hz(&self) -> Option<f32> {
+        let step_deg = self.span_cdeg() as f32 / 100.0 / (POINTS - 1) as f32;
+        (step_deg > 0.0 && self.speed_dps > 0).then(|| f32::from(self.speed_dps) / step_deg)
     }
 
     /// The packet span in whole degrees, by the vendors' plausibility rule:

@@ -21,6 +21,7 @@
 //! an invariant the tests check on random streams.
 
 use super::packet::{PACKET_LEN, Packet, Repr, SYNC_BYTE, is_index_byte};
+use crate::framing::{Candidate, skip_to};
 
 /// Bytes the decoder buffers: exactly one packet.
 pub const DECODER_BUFFER_LEN: usize = PACKET_LEN;
@@ -66,8 +67,7 @@ pub struct Decoded {
 /// The streaming decoder. Allocation-free; `const`-constructible so it can live in a `static`.
 #[derive(Debug, Clone)]
 pub struct Decoder {
-    buf: [u8; DECODER_BUFFER_LEN],
-    len: usize,
+    cand: Candidate<DECODER_BUFFER_LEN>,
     policy: ChecksumPolicy,
     stats: DecoderStats,
 }
@@ -82,8 +82,7 @@ impl Decoder {
     /// A decoder with the given checksum policy.
     pub const fn new(policy: ChecksumPolicy) -> Self {
         Decoder {
-            buf: [0; DECODER_BUFFER_LEN],
-            len: 0,
+            cand: Candidate::new(),
             policy,
             stats: DecoderStats {
                 bytes_in: 0,
@@ -107,13 +106,12 @@ impl Decoder {
 
     /// Bytes held in the buffer waiting for the rest of a packet.
     pub fn buffered(&self) -> usize {
-        self.len
+        self.cand.len()
     }
 
     /// Drops any partial packet (counted as skipped), e.g. after the link was reopened.
     pub fn reset(&mut self) {
-        self.stats.bytes_skipped += self.len as u64;
-        self.len = 0;
+        self.stats.bytes_skipped += self.cand.clear() as u64;
     }
 
     /// Iterates over the packets in `input`, continuing any packet begun by earlier chunks.
@@ -131,24 +129,17 @@ impl Decoder {
     /// `None` once `input` is used up. The building block of [`Decoder::feed`].
     pub fn next_packet(&mut self, input: &mut &[u8]) -> Option<Decoded> {
         loop {
-            if self.len == 0 {
+            if self.cand.len() == 0 {
                 // Hunt for sync in the input itself: no copying of garbage.
-                match input.iter().position(|&b| b == SYNC_BYTE) {
-                    Some(p) => {
-                        self.stats.bytes_in += p as u64;
-                        self.stats.bytes_skipped += p as u64;
-                        *input = &input[p..];
-                    }
-                    None => {
-                        self.stats.bytes_in += input.len() as u64;
-                        self.stats.bytes_skipped += input.len() as u64;
-                        *input = &[];
-                        return None;
-                    }
+                let skipped = skip_to(input, SYNC_BYTE) as u64;
+                self.stats.bytes_in += skipped;
+                self.stats.bytes_skipped += skipped;
+                if input.is_empty() {
+                    return None;
                 }
             }
             // Fast path: a whole packet in the input with a good checksum is parsed in place.
-            if self.len == 0
+            if self.cand.len() == 0
                 && let Some(candidate) = input.get(..PACKET_LEN)
                 && let Ok(packet) = Packet::new_checked(candidate)
                 && packet.checksum_ok()
@@ -163,23 +154,19 @@ impl Decoder {
                 });
             }
             // Anything else takes the general path below, which counts and resyncs.
-            let take = (DECODER_BUFFER_LEN - self.len).min(input.len());
-            self.buf[self.len..self.len + take].copy_from_slice(&input[..take]);
-            self.len += take;
-            self.stats.bytes_in += take as u64;
-            *input = &input[take..];
+            self.stats.bytes_in += self.cand.fill(input, DECODER_BUFFER_LEN) as u64;
 
-            if self.len >= 2 && !is_index_byte(self.buf[1]) {
+            if self.cand.bytes().get(1).is_some_and(|&b| !is_index_byte(b)) {
                 self.stats.bad_index += 1;
                 self.resync();
                 continue;
             }
-            if self.len < DECODER_BUFFER_LEN {
+            if self.cand.len() < DECODER_BUFFER_LEN {
                 return None;
             }
             // Sync and index were checked above and the length is exact: this cannot fail,
             // but stay panic-free and treat a failure as a bad candidate.
-            let Ok(packet) = Packet::new_checked(&self.buf[..]) else {
+            let Ok(packet) = Packet::new_checked(self.cand.bytes()) else {
                 self.resync();
                 continue;
             };
@@ -192,7 +179,7 @@ impl Decoder {
                 }
             }
             let repr = Repr::parse(&packet);
-            self.len = 0;
+            self.cand.clear();
             self.stats.packets += 1;
             return Some(Decoded { repr, checksum_ok });
         }
@@ -201,21 +188,7 @@ impl Decoder {
     /// Rejects the candidate at the front of the buffer: drops its sync byte and everything
     /// up to the next `0xFA` already buffered.
     fn resync(&mut self) {
-        let next = self.buf[1..self.len]
-            .iter()
-            .position(|&b| b == SYNC_BYTE)
-            .map(|p| p + 1);
-        match next {
-            Some(start) => {
-                self.buf.copy_within(start..self.len, 0);
-                self.len -= start;
-                self.stats.bytes_skipped += start as u64;
-            }
-            None => {
-                self.stats.bytes_skipped += self.len as u64;
-                self.len = 0;
-            }
-        }
+        self.stats.bytes_skipped += self.cand.resync(SYNC_BYTE) as u64;
     }
 }
 

@@ -116,20 +116,13 @@ impl Detector {
         while self.lds01.next_packet(&mut input).is_some() {}
         let mut input = bytes;
         while let Some(item) = self.ldrobot.next_frame(&mut input) {
-            if let ldrobot::Decoded::Measurement(f) = item {
-                let step = f32::from(
-                    ((u32::from(f.end_angle_cdeg) + 36_000
-                        - u32::from(f.start_angle_cdeg) % 36_000)
-                        % 36_000) as u16,
-                ) / 100.0
-                    / 11.0;
-                if step > 0.0 && f.speed_dps > 0 {
-                    let rate = f32::from(f.speed_dps) / step;
-                    if rate < 3400.0 {
-                        self.ld_rate_votes.0 += 1;
-                    } else {
-                        self.ld_rate_votes.1 += 1;
-                    }
+            if let ldrobot::Decoded::Measurement(f) = item
+                && let Some(rate) = f.sample_rate_hz()
+            {
+                if rate < 3400.0 {
+                    self.ld_rate_votes.0 += 1;
+                } else {
+                    self.ld_rate_votes.1 += 1;
                 }
             }
         }

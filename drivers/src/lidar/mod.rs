@@ -200,6 +200,8 @@ pub struct LidarFaults {
 }
 
 /// A LiDAR byte decoder: bytes in any chunking → [`Revolution`]s. Every model implements it.
+/// Object-safe (the generic [`LidarStream::feed`] needs `Sized`), so [`AnyLidar`] forwards
+/// through `&dyn LidarStream`.
 pub trait LidarStream {
     /// Which model this decodes.
     fn model(&self) -> LidarModel;
@@ -331,7 +333,7 @@ impl AnyLidar {
         }
     }
 
-    fn inner(&self) -> &dyn LidarStreamDyn {
+    fn inner(&self) -> &dyn LidarStream {
         match self {
             AnyLidar::Lds01(s) => s,
             AnyLidar::Ldrobot(s) => s,
@@ -339,52 +341,12 @@ impl AnyLidar {
         }
     }
 
-    fn inner_mut(&mut self) -> &mut dyn LidarStreamDyn {
+    fn inner_mut(&mut self) -> &mut dyn LidarStream {
         match self {
             AnyLidar::Lds01(s) => s,
             AnyLidar::Ldrobot(s) => s,
             AnyLidar::Rplidar(s) => s,
         }
-    }
-}
-
-/// The object-safe part of [`LidarStream`] (everything but the generic `feed`), so
-/// [`AnyLidar`] forwards each call once instead of matching in every method.
-trait LidarStreamDyn {
-    fn model(&self) -> LidarModel;
-    fn next_revolution(&mut self, input: &mut &[u8], host_us: Option<u64>) -> bool;
-    fn last_revolution(&self) -> Option<&Revolution>;
-    fn poll(&mut self, now_us: u64) -> Option<&Revolution>;
-    fn finish(&mut self) -> Option<&Revolution>;
-    fn link_reset(&mut self);
-    fn sensor_time_s(&self) -> f64;
-    fn faults(&self) -> LidarFaults;
-}
-
-impl<S: LidarStream> LidarStreamDyn for S {
-    fn model(&self) -> LidarModel {
-        LidarStream::model(self)
-    }
-    fn next_revolution(&mut self, input: &mut &[u8], host_us: Option<u64>) -> bool {
-        LidarStream::next_revolution(self, input, host_us)
-    }
-    fn last_revolution(&self) -> Option<&Revolution> {
-        LidarStream::last_revolution(self)
-    }
-    fn poll(&mut self, now_us: u64) -> Option<&Revolution> {
-        LidarStream::poll(self, now_us)
-    }
-    fn finish(&mut self) -> Option<&Revolution> {
-        LidarStream::finish(self)
-    }
-    fn link_reset(&mut self) {
-        LidarStream::link_reset(self)
-    }
-    fn sensor_time_s(&self) -> f64 {
-        LidarStream::sensor_time_s(self)
-    }
-    fn faults(&self) -> LidarFaults {
-        LidarStream::faults(self)
     }
 }
 

@@ -199,7 +199,7 @@ impl PointAssembler {
         let rev = &mut self.bufs[self.filling];
         let valid = p.range_m > 0.0 && p.range_m >= min && p.range_m <= max;
         let old = rev.readings[d];
-        let old_seen = rev.readings[d].range_m > 0.0 || old.intensity > 0 || old.valid;
+        let old_seen = old.range_m > 0.0 || old.intensity > 0 || old.valid;
         let wins = match (valid, old.valid) {
             (true, true) => p.range_m < old.range_m,
             (true, false) => true,

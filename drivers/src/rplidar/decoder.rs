@@ -23,6 +23,7 @@ use super::protocol::{
     DESCRIPTOR_LEN, Descriptor, HealthReply, InfoReply, NODE_LEN, Node, NodeError, SYNC, SYNC2,
     kind,
 };
+use crate::framing::Candidate;
 
 /// Largest clockwise step from the last good node a node found while hunting may take
 /// (10°, 1/64° units).
@@ -75,8 +76,7 @@ pub struct DecoderStats {
 /// The decoder; see the module docs.
 #[derive(Debug, Clone, Default)]
 pub struct Decoder {
-    buf: [u8; DECODER_BUFFER_LEN],
-    len: usize,
+    cand: Candidate<DECODER_BUFFER_LEN>,
     /// Payload length of a single reply announced by the last descriptor, still to read.
     reply: Option<(u8, usize)>,
     /// Bytes slid past since the last good node (0 = in step).
@@ -101,13 +101,12 @@ impl Decoder {
 
     /// Bytes held.
     pub fn buffered(&self) -> usize {
-        self.len
+        self.cand.len()
     }
 
     /// Drops partial data (link reset, end of stream), counting it as skipped.
     pub fn reset(&mut self) {
-        self.stats.bytes_skipped += self.len as u64;
-        self.len = 0;
+        self.stats.bytes_skipped += self.cand.clear() as u64;
         self.reply = None;
         self.hunted = 0;
     }
@@ -117,7 +116,7 @@ impl Decoder {
     pub fn next_item(&mut self, input: &mut &[u8]) -> Option<Decoded> {
         loop {
             // Fast path: nodes straight from the input.
-            if self.len == 0
+            if self.cand.len() == 0
                 && self.reply.is_none()
                 && self.hunted == 0
                 && let Some(b) = input.get(..NODE_LEN)
@@ -130,46 +129,39 @@ impl Decoder {
                 *input = &input[NODE_LEN..];
                 return Some(Decoded::Node(node));
             }
-            if self.reply.is_none() && self.len < 2 {
+            if self.reply.is_none() {
                 // Two bytes tell a descriptor from a node.
-                let take = (2 - self.len).min(input.len());
-                self.buf[self.len..self.len + take].copy_from_slice(&input[..take]);
-                self.len += take;
-                self.stats.bytes_in += take as u64;
-                *input = &input[take..];
-                if self.len < 2 {
+                self.stats.bytes_in += self.cand.fill(input, 2) as u64;
+                if self.cand.len() < 2 {
                     return None;
                 }
             }
             let want = match self.reply {
                 Some((_, n)) => n,
-                None if self.buf[0] == SYNC && self.buf[1] == SYNC2 => DESCRIPTOR_LEN,
+                None if self.cand.bytes()[..2] == [SYNC, SYNC2] => DESCRIPTOR_LEN,
                 None => NODE_LEN,
             };
-            let take = want.saturating_sub(self.len).min(input.len());
-            self.buf[self.len..self.len + take].copy_from_slice(&input[..take]);
-            self.len += take;
-            self.stats.bytes_in += take as u64;
-            *input = &input[take..];
-            if self.len < want {
+            self.stats.bytes_in += self.cand.fill(input, want) as u64;
+            if self.cand.len() < want {
                 return None;
             }
+            let bytes = self.cand.bytes();
             if let Some((k, n)) = self.reply.take() {
-                let body = &self.buf[..n];
+                let body = &bytes[..n];
                 let item = match k {
                     kind::DEVHEALTH => HealthReply::parse(body).map(Decoded::Health),
                     _ => InfoReply::parse(body).map(Decoded::Info),
                 };
-                self.consume(n);
+                self.cand.consume(n);
                 match item {
                     Some(item) => return Some(item),
                     None => continue,
                 }
             }
             if want == DESCRIPTOR_LEN {
-                if let Some(d) = Descriptor::parse(&self.buf[..DESCRIPTOR_LEN]) {
+                if let Some(d) = Descriptor::parse(bytes) {
                     self.stats.descriptors += 1;
-                    self.consume(DESCRIPTOR_LEN);
+                    self.cand.consume(DESCRIPTOR_LEN);
                     let single = d.mode == 0;
                     self.reply = match (d.kind, d.len) {
                         (kind::DEVHEALTH, 3) if single => Some((d.kind, 3)),
@@ -181,9 +173,9 @@ impl Decoder {
                 self.slide();
                 continue;
             }
-            match Node::parse(&self.buf[..NODE_LEN]) {
+            match Node::parse(bytes) {
                 Ok(node) if self.continues(&node) => {
-                    self.consume(NODE_LEN);
+                    self.cand.consume(NODE_LEN);
                     self.stats.nodes += 1;
                     self.hunted = 0;
                     self.track(node.angle_q6);
@@ -205,18 +197,10 @@ impl Decoder {
         }
     }
 
-    /// Removes `n` bytes from the front of the buffer, keeping what follows.
-    fn consume(&mut self, n: usize) {
-        let n = n.min(self.len);
-        self.buf.copy_within(n..self.len, 0);
-        self.len -= n;
-    }
-
     /// Drops the first buffered byte (now hunting for the node boundary).
     fn slide(&mut self) {
-        if self.len > 0 {
-            self.buf.copy_within(1..self.len, 0);
-            self.len -= 1;
+        if self.cand.len() > 0 {
+            self.cand.consume(1);
             self.stats.bytes_skipped += 1;
             self.hunted = self.hunted.saturating_add(1);
         }
