@@ -32,6 +32,7 @@ pub mod eval_b;
 pub mod odom;
 pub mod output;
 pub mod power;
+pub mod reader;
 pub mod report;
 pub mod runner;
 pub mod snapshot;

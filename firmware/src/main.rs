@@ -98,15 +98,7 @@ fn dispatch(cli: Cli) -> Result<(), Failure> {
                 }
             };
             let from_sim = opencr.is_none() && source.is_simulated();
-            let board = opencr.map(|board| PoseInput {
-                state: PoseState::new(cfg.pose_filter(None), false),
-                file: None,
-                queue: Default::default(),
-                opencr: Some(board),
-                compass: None,
-                compass_errors: 0,
-            });
-            let pose = board.or_else(|| from_sim.then(|| {
+            let pose = if from_sim {
                 let cal = source.sim_calibration();
                 match cal {
                     Some((h, _)) => log::info!(
@@ -114,33 +106,29 @@ fn dispatch(cli: Cli) -> Result<(), Failure> {
                         h[0],
                         h[1]
                     ),
-                    None => log::warn!("simulated compass calibration failed: heading from odometry only"),
+                    None => log::warn!(
+                        "simulated compass calibration failed: heading from odometry only"
+                    ),
                 }
-                PoseInput {
-                    state: PoseState::new(cfg.pose_filter(cal), cal.is_some()),
-                    file: None,
-                    queue: Default::default(),
-                    opencr: None,
-                    compass: None,
-                    compass_errors: 0,
+                let p = PoseInput::new(PoseState::new(cfg.pose_filter(cal), cal.is_some()));
+                if let Some(c) = compass {
+                    // A real compass beside the simulated robot: it reads a real field, not
+                    // the simulated one, so it is left out.
+                    drop(c);
+                    log::warn!("--compass ignored: the simulated robot carries its own compass");
                 }
-            }));
-            // A compass on the bus joins whatever gives the pose (or starts one on its own).
-            let pose = match (pose, compass) {
-                (Some(mut p), Some(c)) => {
-                    p.state.use_compass = compass_calibrated;
-                    p.compass = Some(c);
-                    Some(p)
-                }
-                (None, Some(c)) => Some(PoseInput {
-                    state: PoseState::new(cfg.pose_filter(None), compass_calibrated),
-                    file: None,
-                    queue: Default::default(),
-                    opencr: None,
-                    compass: Some(c),
-                    compass_errors: 0,
-                }),
-                (p, None) => p,
+                Some(p)
+            } else if opencr.is_some() || compass.is_some() {
+                // The OpenCR and/or compass, polled by the device thread.
+                let use_compass = compass.is_some() && compass_calibrated;
+                let mut p = PoseInput::new(PoseState::new(cfg.pose_filter(None), use_compass));
+                p.devices = Some(
+                    firmware::reader::DeviceReader::start(opencr, compass)
+                        .map_err(|m| (EXIT_FAULT, m))?,
+                );
+                Some(p)
+            } else {
+                None
             };
             run_loop(
                 &mut source,
@@ -243,14 +231,9 @@ fn dispatch(cli: Cli) -> Result<(), Failure> {
                             "no [compass] hard_iron_ut in the configuration: compass readings ignored, heading from odometry only (run `umbra calibrate-compass`)"
                         );
                     }
-                    Some(PoseInput {
-                        state: PoseState::new(cfg.pose_filter(None), use_compass),
-                        file: Some(file),
-                        queue: Default::default(),
-                        opencr: None,
-                        compass: None,
-                        compass_errors: 0,
-                    })
+                    let mut p = PoseInput::new(PoseState::new(cfg.pose_filter(None), use_compass));
+                    p.file = Some(file);
+                    Some(p)
                 }
                 None => None,
             };

@@ -125,6 +125,8 @@ pub struct FaultsOut {
     /// Errors the LiDAR reported itself (LDROBOT health frames: blocked motor, occlusion;
     /// RPLIDAR health replies with status error).
     pub lidar_sensor_errors: u64,
+    /// LDS-01 packets whose speed field says the motor is stalled (below 60 rpm).
+    pub lidar_stalled_packets: u64,
     /// Link losses (read errors, hang-ups).
     pub lidar_link_lost: u64,
     /// Link reopens.
@@ -141,6 +143,9 @@ pub struct FaultsOut {
     pub method_b_skipped: u64,
     /// Frames whose cloud work was shrunk by the overrun policy.
     pub cloud_shrunk: u64,
+    /// Encoder/compass samples the device thread dropped because its queue was full (the
+    /// loop stalled for seconds).
+    pub odometry_dropped: u64,
     /// Frames that ended with the loop behind the LiDAR (more than a revolution of bytes
     /// queued, or the simulated sensor ahead by more than a revolution).
     pub behind_lidar: u64,
@@ -162,6 +167,7 @@ impl FaultsOut {
             lidar_invalid_readings: invalid_readings,
             lidar_implausible_frames: f.implausible_frames,
             lidar_sensor_errors: f.sensor_errors,
+            lidar_stalled_packets: f.stalled_packets,
             lidar_link_lost: link.0,
             lidar_link_reopened: link.1,
             ..FaultsOut::default()
@@ -178,9 +184,16 @@ pub struct LidarOut {
     pub packets: u8,
     /// Valid readings of 360.
     pub valid: u32,
-    /// Bytes queued on the port when the frame ended (a real LiDAR's queue depth).
+    /// Bytes not yet decoded when the frame ended: in the reader thread's queue plus in the
+    /// kernel's buffer (a real LiDAR's queue depth).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub backlog_bytes: Option<u32>,
+    /// Chunks in the reader thread's queue when the frame ended (serial sources).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub queue_chunks: Option<usize>,
+    /// The deepest that queue has been so far (serial sources).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub queue_chunks_max: Option<usize>,
 }
 
 /// One output line (`interfaces.md` §3).

@@ -43,7 +43,7 @@ impl YoloModel {
     }
 }
 
-use drivers::opencr::OpencrReader;
+use crate::reader::{ClockMap, DeviceReader};
 
 #[cfg(feature = "viz")]
 pub use crate::viz::VizLink;
@@ -199,61 +199,79 @@ const OUT_CAPACITY: usize =
 /// over 2 s; older ones are fed at once rather than dropped).
 pub const ODOM_QUEUE: usize = 40;
 
+/// Room for samples waiting in the pose input's queue: a live source's backlog plus a full
+/// device-thread queue drained at once. Reserved at start-up; a sample that would grow it is
+/// fed at once instead.
+pub const POSE_QUEUE: usize = ODOM_QUEUE + crate::reader::DEVICE_QUEUE + 1;
+
 /// Where the pose comes from.
 pub struct PoseInput {
     /// The filter and its fault counters.
     pub state: PoseState,
     /// An `--odom` file, read in step with the frames.
     pub file: Option<OdomFile>,
-    /// Samples from a live source (the simulator), waiting for their frame.
+    /// Samples from a live source (the simulator, the device thread), waiting for their frame.
     pub queue: VecDeque<OdomRecord>,
-    /// An OpenCR board, polled once per frame.
-    pub opencr: Option<OpencrReader>,
-    /// A compass, read once per frame (µT, robot frame).
-    pub compass: Option<CompassReader>,
-    /// Compass reads that failed.
-    pub compass_errors: u64,
+    /// The OpenCR and compass, polled by their own thread.
+    pub devices: Option<DeviceReader>,
+    /// Host time → LiDAR time, for the device thread's samples.
+    pub clock: ClockMap,
 }
 
-/// Reads the compass once; the error names the device.
-pub type CompassReader = Box<dyn FnMut() -> Result<[f32; 3], String>>;
+/// Reads the compass once; the error names the device. Runs on the device thread.
+pub type CompassReader = Box<dyn FnMut() -> Result<[f32; 3], String> + Send>;
 
 impl PoseInput {
-    /// Reads the OpenCR and the compass once (a frame's device I/O) and feeds what they gave,
-    /// stamped at sensor time `t`.
-    fn poll_devices(&mut self, t: f64) {
-        if let Some(board) = self.opencr.as_mut() {
-            match board.poll() {
-                Ok((l, r)) => self.state.feed(&OdomRecord {
-                    t,
-                    left_ticks: Some(i64::from(l)),
-                    right_ticks: Some(i64::from(r)),
-                    mag_ut: None,
-                }),
-                Err(e) => {
-                    if self.state.encoder_errors == 0 {
-                        log::warn!("{e}; pose continues from the last good ticks");
-                    }
-                    self.state.encoder_errors += 1;
+    /// A pose input fed by `state` alone, with room reserved for queued samples.
+    pub fn new(state: PoseState) -> Self {
+        PoseInput {
+            state,
+            file: None,
+            queue: VecDeque::with_capacity(POSE_QUEUE),
+            devices: None,
+            clock: ClockMap::default(),
+        }
+    }
+
+    /// Moves the device thread's samples into the queue, stamped on the LiDAR's clock
+    /// (`start` is the run's host-clock origin). Before the first revolution maps the clocks
+    /// a sample is stamped at `fallback`.
+    fn take_device_samples(&mut self, start: Instant, fallback: f64) {
+        let Some(dev) = self.devices.as_ref() else {
+            return;
+        };
+        while let Some(s) = dev.try_next() {
+            let host_s = s.host.saturating_duration_since(start).as_secs_f64();
+            let t = self.clock.sensor_time(host_s).unwrap_or(fallback);
+            if self.queue.len() >= self.queue.capacity() {
+                // Never grow: feed the oldest now (only if the loop stalled for seconds).
+                if let Some(r) = self.queue.pop_front() {
+                    self.state.feed(&r);
                 }
             }
+            self.queue.push_back(OdomRecord {
+                t,
+                left_ticks: s.ticks.map(|(l, _)| i64::from(l)),
+                right_ticks: s.ticks.map(|(_, r)| i64::from(r)),
+                mag_ut: s.mag_ut,
+            });
         }
-        if let Some(read) = self.compass.as_mut() {
-            match read() {
-                Ok(m) => self.state.feed(&OdomRecord {
-                    t,
-                    left_ticks: None,
-                    right_ticks: None,
-                    mag_ut: Some(m),
-                }),
-                Err(e) => {
-                    if self.compass_errors == 0 {
-                        log::warn!("{e}; heading continues on odometry");
-                    }
-                    self.compass_errors += 1;
-                }
-            }
-        }
+    }
+
+    /// Encoder faults: the filter's (implausible ticks) plus failed polls.
+    fn encoder_errors(&self) -> u64 {
+        self.state.encoder_errors
+            + self
+                .devices
+                .as_ref()
+                .map_or(0, DeviceReader::encoder_errors)
+    }
+
+    /// Failed compass reads.
+    fn compass_errors(&self) -> u64 {
+        self.devices
+            .as_ref()
+            .map_or(0, DeviceReader::compass_errors)
     }
 
     /// Feeds every file or queued sample up to sensor time `t` and returns the pose at `t`.
@@ -353,6 +371,7 @@ pub fn run(
         doors: Vec::with_capacity(perception::doors::MAX_DOORS),
     };
 
+    let mut watch = LinkWatch::default();
     let reason = 'outer: loop {
         if opts.stop.load(Ordering::Relaxed) {
             break 'outer "stopped by signal";
@@ -373,6 +392,7 @@ pub fn run(
         let n = match source.read(&mut buf) {
             SourceRead::Data(n) => n,
             SourceRead::Idle => {
+                watch.idle(source, &stream);
                 if !source.is_file()
                     && stream.poll(link_us(state.busy)).is_some()
                     && emit_frame(
@@ -404,6 +424,10 @@ pub fn run(
             SourceRead::Lost(msg) => {
                 log::warn!("{msg}; reopening with back-off");
                 stream.link_reset();
+                if let Some(p) = opts.pose.as_mut() {
+                    // A replugged LiDAR starts a new clock.
+                    p.clock.reset();
+                }
                 continue;
             }
             SourceRead::Reopened => {
@@ -412,6 +436,7 @@ pub fn run(
             }
         };
         summary.bytes += n as u64;
+        watch.data();
         if let Some(p) = opts.pose.as_mut() {
             source.drain_odometry(&mut p.queue);
         }
@@ -423,6 +448,10 @@ pub fn run(
             ingest += t_feed.elapsed();
             if !done {
                 break;
+            }
+            if let (Some(p), Some(host)) = (opts.pose.as_mut(), source.last_read_host()) {
+                let host_s = host.saturating_duration_since(start).as_secs_f64();
+                p.clock.observe(host_s, stream.sensor_time_s());
             }
             let limit = emit_frame(
                 &stream,
@@ -436,6 +465,7 @@ pub fn run(
                 break 'outer "frame limit";
             }
         }
+        watch.after_feed(&stream, summary.frames);
         if opts.pacing == Pacing::RealTime {
             let ahead = stream.sensor_time_s() - start.elapsed().as_secs_f64();
             if ahead > 0.0 {
@@ -494,6 +524,58 @@ pub fn run(
         w.flush()?;
     }
     Ok(summary)
+}
+
+/// Seconds without a byte from a live LiDAR before the loop says so.
+pub const SILENT_WARN_S: f64 = 2.0;
+
+/// Says (once per episode, in the log) when a live LiDAR falls silent or its motor stalls, and
+/// when it comes back; the counts are in the output line's faults.
+#[derive(Debug, Default)]
+struct LinkWatch {
+    last_data: Option<Instant>,
+    silent: bool,
+    stalled_seen: u64,
+    stalled: bool,
+    frames_at_stall: u64,
+}
+
+impl LinkWatch {
+    fn data(&mut self) {
+        self.last_data = Some(Instant::now());
+        if self.silent {
+            log::info!("LiDAR bytes again");
+            self.silent = false;
+        }
+    }
+
+    fn idle(&mut self, source: &LidarSource, stream: &AnyLidar) {
+        let since = self.last_data.get_or_insert_with(Instant::now).elapsed();
+        if !self.silent && !source.is_file() && since.as_secs_f64() > SILENT_WARN_S {
+            log::warn!(
+                "no bytes from the LiDAR for {SILENT_WARN_S} s ({}): unplugged, unpowered or not spinning? Frames resume when it speaks",
+                stream.model()
+            );
+            self.silent = true;
+        }
+    }
+
+    fn after_feed(&mut self, stream: &AnyLidar, frames: u64) {
+        let stalled = stream.faults().stalled_packets;
+        if stalled > self.stalled_seen {
+            if !self.stalled {
+                log::warn!(
+                    "LiDAR motor stalled: its speed field reads below 60 rpm (faults.lidar_stalled_packets); frames wait for it to turn"
+                );
+                self.stalled = true;
+                self.frames_at_stall = frames;
+            }
+            self.stalled_seen = stalled;
+        } else if self.stalled && frames > self.frames_at_stall + 1 {
+            log::info!("LiDAR motor turning again");
+            self.stalled = false;
+        }
+    }
 }
 
 /// Whether the loop has fallen more than a revolution behind the LiDAR: bytes queued on a
@@ -641,15 +723,15 @@ fn emit_frame(
     let t_end = t + period * 359.0 / 360.0;
     let (pose, end, encoder_errors, compass_rejected, compass_errors) = match opts.pose.as_mut() {
         Some(p) => {
-            p.poll_devices(t);
+            p.take_device_samples(state.start, t);
             let start = p.advance(t);
             let end = p.advance(t_end);
             (
                 start,
                 end,
-                p.state.encoder_errors,
+                p.encoder_errors(),
                 u64::from(p.state.filter.compass_rejected()),
-                p.compass_errors,
+                p.compass_errors(),
             )
         }
         None => (Pose2::IDENTITY, Pose2::IDENTITY, 0, 0, 0),
@@ -810,6 +892,11 @@ fn emit_frame(
                 method_b_skipped: rec.method_b_skipped,
                 cloud_shrunk: rec.cloud_shrunk,
                 behind_lidar: rec.behind_lidar,
+                odometry_dropped: opts
+                    .pose
+                    .as_ref()
+                    .and_then(|p| p.devices.as_ref())
+                    .map_or(0, DeviceReader::dropped),
                 ..FaultsOut::new(
                     &stream.faults(),
                     summary.invalid_readings,
@@ -821,6 +908,8 @@ fn emit_frame(
                 packets: rev.packets,
                 valid,
                 backlog_bytes,
+                queue_chunks: source.queue_depth().map(|q| q.0),
+                queue_chunks_max: source.queue_depth().map(|q| q.1),
             },
         };
         line.write_to(w)?;

@@ -1,19 +1,21 @@
-//! Where LiDAR bytes come from: a serial port, a raw capture file, or the simulated robot.
-//! All three hand bytes to the same decoder.
+//! Where LiDAR bytes come from: a serial port (read by its own thread, [`crate::reader`]), a
+//! raw capture file, or the simulated robot. All three hand bytes to the same decoder.
 
 use std::fs::File;
 use std::path::{Path, PathBuf};
+use std::time::{Duration, Instant};
 
 use drivers::lds01::PACKET_LEN;
 use drivers::lidar::LidarModel;
 use drivers::lidar::detect::{Detector, Verdict};
-use drivers::serial::{LinkRead, SerialConfig, SerialLink};
+use drivers::serial::{SerialConfig, SerialLink};
 use embedded_io::Read as _;
 use embedded_io_adapters::std::FromStd;
 use sim::lds01::Lds01Sim;
 use sim::scenario::{Scenario, ScenarioConfig};
 
 use crate::odom::OdomRecord;
+use crate::reader::{LidarEvent, LidarReader};
 
 /// What one read gave.
 #[derive(Debug)]
@@ -41,8 +43,15 @@ pub enum Pacing {
 
 /// A LiDAR byte source.
 pub enum LidarSource {
-    /// A serial port that reopens itself, and the model on it.
-    Serial(SerialLink, LidarModel),
+    /// A serial port that reopens itself, read by its own thread, and the model on it.
+    Serial {
+        /// The reader thread's end.
+        reader: LidarReader,
+        /// The model on the port.
+        model: LidarModel,
+        /// When the last bytes handed out were read.
+        last_host: Option<Instant>,
+    },
     /// A raw capture file read through `embedded-io`.
     Capture {
         /// The file's path, for messages.
@@ -68,6 +77,9 @@ pub const PROBE_LISTEN_MS: u64 = 1500;
 /// Bytes of a capture read to recognise its model (several revolutions of any model).
 pub const DETECT_BYTES: usize = 64 * 1024;
 
+/// How long a read of a serial source waits for the reader thread.
+pub const SERIAL_WAIT: Duration = Duration::from_millis(20);
+
 /// Packets the simulated source produces per read (a tenth of a revolution).
 pub const SIM_PACKETS_PER_READ: usize = 6;
 
@@ -77,14 +89,12 @@ impl LidarSource {
     /// recognised is an error naming the port and, per baud rate, what was seen.
     pub fn serial(path: &str, model: Option<LidarModel>) -> Result<(Self, String), String> {
         if let Some(model) = model {
-            return SerialLink::open(path, SerialConfig::lidar(model))
-                .map(|l| {
-                    (
-                        LidarSource::Serial(l, model),
-                        format!("{model} named on {path}"),
-                    )
-                })
-                .map_err(|e| e.to_string());
+            let link =
+                SerialLink::open(path, SerialConfig::lidar(model)).map_err(|e| e.to_string())?;
+            return Ok((
+                LidarSource::threaded(link, model)?,
+                format!("{model} named on {path}"),
+            ));
         }
         let probe = drivers::probe::probe(
             path,
@@ -100,12 +110,20 @@ impl LidarSource {
                     ..SerialConfig::lidar(model)
                 };
                 Ok((
-                    LidarSource::Serial(SerialLink::from_open(path, cfg, port), model),
+                    LidarSource::threaded(SerialLink::from_open(path, cfg, port), model)?,
                     summary,
                 ))
             }
             None => Err(summary),
         }
+    }
+
+    fn threaded(link: SerialLink, model: LidarModel) -> Result<Self, String> {
+        Ok(LidarSource::Serial {
+            reader: LidarReader::start(link)?,
+            model,
+            last_host: None,
+        })
     }
 
     /// Opens a raw capture file of `model`, or (`None`) recognises the model from its first
@@ -165,7 +183,7 @@ impl LidarSource {
     /// The model whose bytes this source gives.
     pub fn model(&self) -> LidarModel {
         match self {
-            LidarSource::Serial(_, m) => *m,
+            LidarSource::Serial { model, .. } => *model,
             LidarSource::Capture { model, .. } => *model,
             LidarSource::Sim { .. } => LidarModel::Lds01,
         }
@@ -216,8 +234,8 @@ impl LidarSource {
     /// One line saying what this source is.
     pub fn describe(&self) -> String {
         match self {
-            LidarSource::Serial(link, model) => {
-                format!("{model} on serial port {}", link.path())
+            LidarSource::Serial { reader, model, .. } => {
+                format!("{model} on serial port {}", reader.path())
             }
             LidarSource::Capture { path, model, .. } => {
                 format!("raw {model} capture {}", path.display())
@@ -240,10 +258,30 @@ impl LidarSource {
         matches!(self, LidarSource::Capture { .. })
     }
 
-    /// Bytes queued on a serial port, unread (`None` for other sources or a closed port).
+    /// Bytes from a serial port not yet decoded: queued by the reader thread plus waiting in
+    /// the kernel (`None` for other sources or a closed port).
     pub fn backlog_bytes(&self) -> Option<u32> {
         match self {
-            LidarSource::Serial(link, _) => link.backlog_bytes(),
+            LidarSource::Serial { reader, .. } => reader.backlog_bytes(),
+            _ => None,
+        }
+    }
+
+    /// The reader thread's queue: chunks waiting now, and the deepest it has been (`None` for
+    /// sources without a thread).
+    pub fn queue_depth(&self) -> Option<(usize, usize)> {
+        match self {
+            LidarSource::Serial { reader, .. } => {
+                Some((reader.queue_depth(), reader.max_queue_depth()))
+            }
+            _ => None,
+        }
+    }
+
+    /// When the bytes of the last read came off the port (serial sources only).
+    pub fn last_read_host(&self) -> Option<Instant> {
+        match self {
+            LidarSource::Serial { last_host, .. } => *last_host,
             _ => None,
         }
     }
@@ -251,11 +289,19 @@ impl LidarSource {
     /// Reads what is available into `buf`.
     pub fn read(&mut self, buf: &mut [u8]) -> SourceRead {
         match self {
-            LidarSource::Serial(link, _) => match link.read(buf) {
-                LinkRead::Data(n) => SourceRead::Data(n),
-                LinkRead::Idle => SourceRead::Idle,
-                LinkRead::Lost(e) => SourceRead::Lost(e.to_string()),
-                LinkRead::Reopened => SourceRead::Reopened,
+            LidarSource::Serial {
+                reader, last_host, ..
+            } => match reader.next(SERIAL_WAIT) {
+                Some(LidarEvent::Data(chunk)) => {
+                    let n = chunk.len.min(buf.len());
+                    buf[..n].copy_from_slice(&chunk.data[..n]);
+                    *last_host = Some(chunk.host);
+                    reader.recycle(chunk);
+                    SourceRead::Data(n)
+                }
+                None => SourceRead::Idle,
+                Some(LidarEvent::Lost(msg)) => SourceRead::Lost(msg),
+                Some(LidarEvent::Reopened) => SourceRead::Reopened,
             },
             LidarSource::Capture { path, file, .. } => match file.read(buf) {
                 Ok(0) => SourceRead::End,
@@ -279,10 +325,7 @@ impl LidarSource {
     /// Link counters of a serial source: (errors + EOFs, reopens).
     pub fn link_counts(&self) -> (u64, u64) {
         match self {
-            LidarSource::Serial(link, _) => {
-                let s = link.stats();
-                (s.read_errors + s.eofs, s.reopens)
-            }
+            LidarSource::Serial { reader, .. } => reader.link_counts(),
             _ => (0, 0),
         }
     }

@@ -65,14 +65,10 @@ fn per_frame_with(method_b: bool, viz: Option<runner::VizLink>) -> Vec<u64> {
         jsonl: Some(Box::new(Marks(marks.clone()))),
         stats: Some(Box::new(std::io::sink())),
         stop: Arc::new(AtomicBool::new(false)),
-        pose: Some(PoseInput {
-            state: PoseState::new(cfg.pose_filter(cal), cal.is_some()),
-            file: None,
-            queue: Default::default(),
-            opencr: None,
-            compass: None,
-            compass_errors: 0,
-        }),
+        pose: Some(PoseInput::new(PoseState::new(
+            cfg.pose_filter(cal),
+            cal.is_some(),
+        ))),
         method_a: Some((cfg.method_a(), cfg.lidar_mount())),
         method_b: b,
         viz,

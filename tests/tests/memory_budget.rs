@@ -164,6 +164,26 @@ fn buffers_in_code() -> Vec<(&'static str, usize, usize)> {
             size_of::<firmware::viz::VizFrame>(),
         ),
         (
+            "firmware::reader::CHUNK_POOL",
+            firmware::reader::CHUNK_POOL,
+            size_of::<firmware::reader::Chunk>(),
+        ),
+        (
+            "firmware::reader::DEVICE_QUEUE",
+            firmware::reader::DEVICE_QUEUE,
+            size_of::<firmware::reader::DeviceSample>(),
+        ),
+        (
+            "firmware::runner::POSE_QUEUE",
+            firmware::runner::POSE_QUEUE,
+            size_of::<firmware::odom::OdomRecord>(),
+        ),
+        (
+            "size_of::<firmware::reader::ClockMap>()",
+            1,
+            size_of::<firmware::reader::ClockMap>(),
+        ),
+        (
             "size_of::<perception::yolo::DecodeScratch>()",
             1,
             size_of::<perception::yolo::DecodeScratch>(),

@@ -78,6 +78,9 @@ pub struct AssemblerStats {
     /// because their index does not follow the previous packet's: a corrupted index would
     /// put six readings at the wrong angles and split the revolution.
     pub out_of_sequence_bad_packets: u64,
+    /// Packets with a good checksum whose speed field says the motor is stalled or far off
+    /// speed (below [`MIN_PLAUSIBLE_RPM`]): the clock keeps the last plausible speed.
+    pub stalled_packets: u64,
 }
 
 #[derive(Debug, Clone, Copy)]
@@ -174,6 +177,9 @@ impl Assembler {
         let k = repr.index;
         if usize::from(k) >= PACKETS_PER_REV {
             return false; // unreachable through the decoder; never index out of bounds
+        }
+        if packet.checksum_ok && repr.rpm() < MIN_PLAUSIBLE_RPM {
+            self.stats.stalled_packets += 1;
         }
         if self.clock.started && k == self.clock.last_index {
             self.stats.repeated_packets += 1;

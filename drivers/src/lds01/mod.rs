@@ -151,6 +151,7 @@ impl LidarStream for Lds01Stream {
             repeated_packets: a.repeated_packets,
             out_of_sequence_bad_packets: a.out_of_sequence_bad_packets,
             incomplete_revolutions: a.incomplete_revolutions,
+            stalled_packets: a.stalled_packets,
             ..LidarFaults::default()
         }
     }

@@ -197,6 +197,8 @@ pub struct LidarFaults {
     pub implausible_frames: u64,
     /// Error reports from the sensor itself (LDROBOT health frames with an error code).
     pub sensor_errors: u64,
+    /// LDS-01: good packets whose speed field says the motor is stalled (below 60 rpm).
+    pub stalled_packets: u64,
 }
 
 /// A LiDAR byte decoder: bytes in any chunking → [`Revolution`]s. Every model implements it.
