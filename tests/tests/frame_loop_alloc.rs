@@ -43,8 +43,19 @@ fn per_frame(method_b: bool) -> Vec<u64> {
 
 fn per_frame_with(method_b: bool, viz: Option<runner::VizLink>) -> Vec<u64> {
     let cfg = Config::default();
-    let mut source = LidarSource::sim(3, 3);
+    let source = LidarSource::sim(3, 3);
     let cal = source.sim_calibration();
+    let pose = PoseInput::new(PoseState::new(cfg.pose_filter(cal), cal.is_some()));
+    per_frame_from(source, pose, method_b, viz)
+}
+
+fn per_frame_from(
+    mut source: LidarSource,
+    pose: PoseInput,
+    method_b: bool,
+    viz: Option<runner::VizLink>,
+) -> Vec<u64> {
+    let cfg = Config::default();
     let marks = Arc::new(std::sync::Mutex::new(Vec::with_capacity(
         FRAMES as usize + 8,
     )));
@@ -65,10 +76,7 @@ fn per_frame_with(method_b: bool, viz: Option<runner::VizLink>) -> Vec<u64> {
         jsonl: Some(Box::new(Marks(marks.clone()))),
         stats: Some(Box::new(std::io::sink())),
         stop: Arc::new(AtomicBool::new(false)),
-        pose: Some(PoseInput::new(PoseState::new(
-            cfg.pose_filter(cal),
-            cal.is_some(),
-        ))),
+        pose: Some(pose),
         method_a: Some((cfg.method_a(), cfg.lidar_mount())),
         method_b: b,
         viz,
@@ -127,4 +135,60 @@ fn recording_costs_the_loop_no_allocation() {
         "frames were recorded"
     );
     std::fs::remove_file(&path).ok();
+}
+
+/// An LDS-01 on a pty, played at its real rate until `stop`.
+fn play_lds01(mut master: serialport::TTYPort, stop: Arc<AtomicBool>) {
+    use std::io::Write as _;
+    let mut sim = sim::lds01::Lds01Sim::new(
+        sim::world::World::random_room(5),
+        sim::lds01::Lds01SimConfig::default(),
+        5,
+    );
+    let start = std::time::Instant::now();
+    let mut t = 0.0;
+    let mut packet = [0u8; drivers::lds01::PACKET_LEN];
+    while !stop.load(std::sync::atomic::Ordering::Relaxed) {
+        t += sim.slot_s();
+        sim.emit_packet(&mut packet);
+        let _ = master.write_all(&packet);
+        let due = start + std::time::Duration::from_secs_f64(t);
+        if let Some(wait) = due.checked_duration_since(std::time::Instant::now()) {
+            std::thread::sleep(wait);
+        }
+    }
+}
+
+#[test]
+fn serial_source_with_reader_threads_allocates_nothing_after_warm_up() {
+    // The LiDAR's reader thread and the device thread (here a compass that always answers)
+    // hand their data over through the fixed-capacity queues: the loop's thread allocates
+    // nothing for them.
+    let dir = std::env::temp_dir().join(format!("umbra-alloc-serial-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let link = dir.join("ttyLDS");
+    let master = umbra_tests::plug_pty(&link, std::time::Duration::from_millis(5));
+    let stop = Arc::new(AtomicBool::new(false));
+    let player = {
+        let stop = stop.clone();
+        std::thread::spawn(move || play_lds01(master, stop))
+    };
+    let (source, _) = LidarSource::serial(
+        link.to_str().unwrap(),
+        Some(drivers::lidar::LidarModel::Lds01),
+    )
+    .expect("open the pty");
+    let cfg = Config::default();
+    let mut pose = PoseInput::new(PoseState::new(cfg.pose_filter(None), false));
+    let compass: runner::CompassReader = Box::new(|| Ok([21.5, -3.2, 40.1]));
+    pose.devices = Some(firmware::reader::DeviceReader::start(None, Some(compass)).unwrap());
+    let d = per_frame_from(source, pose, false, None);
+    stop.store(true, std::sync::atomic::Ordering::Relaxed);
+    player.join().unwrap();
+    println!("allocations per frame, serial LDS-01 + device thread, Method A: {d:?}");
+    assert!(
+        d[WARM_UP..].iter().all(|&n| n == 0),
+        "frames after warm-up allocated: {d:?}"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
 }
