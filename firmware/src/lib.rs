@@ -33,6 +33,8 @@ pub mod odom;
 pub mod output;
 pub mod power;
 pub mod reader;
+#[cfg(feature = "viz")]
+pub mod recording;
 pub mod report;
 pub mod runner;
 pub mod snapshot;

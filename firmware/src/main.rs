@@ -218,12 +218,25 @@ fn dispatch(cli: Cli) -> Result<(), Failure> {
         Command::Replay(args) => {
             let cfg = load_config(&args.common)?;
             let named = named_model(args.common.lidar_model);
-            let (mut source, how) =
-                LidarSource::capture(&args.capture, named).map_err(|m| (EXIT_USAGE, m))?;
+            let (mut source, how, recorded) = open_replay(&args.capture, named)?;
             log::info!("LiDAR: {how}");
             println!("umbra: {}", source.describe());
-            let pose = match &args.odom {
-                Some(path) => {
+            let pose = match (&args.odom, recorded) {
+                (None, Some((samples, bad, cal))) => {
+                    // The recording's own odometry, with the simulated compass's calibration if
+                    // it carried one, else the configuration's.
+                    let use_compass = cal.is_some() || cfg.compass.hard_iron_ut.is_some();
+                    log::info!(
+                        "odometry: {} samples recorded in {}",
+                        samples.len(),
+                        args.capture.display()
+                    );
+                    let mut p = PoseInput::new(PoseState::new(cfg.pose_filter(cal), use_compass));
+                    p.state.encoder_errors = bad;
+                    p.scheduled = samples;
+                    Some(p)
+                }
+                (Some(path), _) => {
                     let file = OdomFile::open(path).map_err(|m| (EXIT_USAGE, m))?;
                     let use_compass = cfg.compass.hard_iron_ut.is_some();
                     if !use_compass {
@@ -235,7 +248,7 @@ fn dispatch(cli: Cli) -> Result<(), Failure> {
                     p.file = Some(file);
                     Some(p)
                 }
-                None => None,
+                (None, None) => None,
             };
             let pacing = match args.speed {
                 Speed::Max => Pacing::Max,
@@ -251,6 +264,42 @@ fn dispatch(cli: Cli) -> Result<(), Failure> {
             )
         }
     }
+}
+
+/// Odometry lines and compass calibration a recording carried.
+type Recorded = Option<(
+    Vec<(u64, firmware::odom::OdomRecord)>,
+    u64,
+    Option<([f32; 2], [f32; 2])>,
+)>;
+
+/// The replay source: an MCAP recording of umbra's (its LiDAR bytes, plus its odometry when it
+/// has any) or a raw capture.
+fn open_replay(
+    path: &std::path::Path,
+    named: Option<drivers::lidar::LidarModel>,
+) -> Result<(LidarSource, String, Recorded), Failure> {
+    #[cfg(feature = "viz")]
+    if firmware::recording::is_mcap(path) {
+        let mut rec = firmware::recording::read(path).map_err(|m| (EXIT_USAGE, m))?;
+        if let Some(s) = &rec.source {
+            log::info!("recording of: {s}");
+        }
+        let (source, how) = LidarSource::recorded(&mut rec, named).map_err(|m| (EXIT_USAGE, m))?;
+        let odometry = std::mem::take(&mut rec.odometry);
+        let recorded =
+            (!odometry.is_empty()).then_some((odometry, rec.bad_odometry, rec.compass_calibration));
+        return Ok((source, how, recorded));
+    }
+    #[cfg(not(feature = "viz"))]
+    if path.extension().is_some_and(|e| e == "mcap") {
+        log::warn!(
+            "{}: this umbra was built without the viz feature and cannot read MCAP; replaying the file as raw bytes",
+            path.display()
+        );
+    }
+    let (source, how) = LidarSource::capture(path, named).map_err(|m| (EXIT_USAGE, m))?;
+    Ok((source, how, None))
 }
 
 /// Opens an LSM303AGR on the I²C bus at `bus` (e.g. `/dev/i2c-1`); a failure is reported once
@@ -335,7 +384,7 @@ fn run_loop(
     let method_b = load_method_b(cfg, common)?;
     let power = PowerMeter::start(&cfg.power).map_err(|e| (EXIT_USAGE, e))?;
     log::info!("power: {}", power.source());
-    let viz = start_viz(common)?;
+    let viz = start_viz(common, source)?;
     if let Some(p) = &common.snapshot {
         firmware::snapshot::check_path(p).map_err(|m| (EXIT_USAGE, format!("--snapshot {m}")))?;
     }
@@ -368,7 +417,7 @@ fn run_loop(
 
 /// Opens the MCAP file and/or the live server (`--record`, `--live`).
 #[cfg(feature = "viz")]
-fn start_viz(common: &Common) -> Result<Option<runner::VizLink>, Failure> {
+fn start_viz(common: &Common, source: &LidarSource) -> Result<Option<runner::VizLink>, Failure> {
     if common.record.is_none() && common.live.is_none() {
         return Ok(None);
     }
@@ -378,6 +427,7 @@ fn start_viz(common: &Common) -> Result<Option<runner::VizLink>, Failure> {
     let targets = firmware::viz::VizTargets {
         record: common.record.clone(),
         live: common.live,
+        meta: source.recording_meta(),
     };
     let link = runner::VizLink::start(&targets).map_err(|m| (EXIT_USAGE, m))?;
     if let Some(port) = link.live_port() {
@@ -393,7 +443,7 @@ fn start_viz(common: &Common) -> Result<Option<runner::VizLink>, Failure> {
 
 /// Built without the `viz` feature: `--record` and `--live` are errors.
 #[cfg(not(feature = "viz"))]
-fn start_viz(common: &Common) -> Result<Option<runner::VizLink>, Failure> {
+fn start_viz(common: &Common, _source: &LidarSource) -> Result<Option<runner::VizLink>, Failure> {
     if common.record.is_some() || common.live.is_some() {
         return Err((
             EXIT_USAGE,

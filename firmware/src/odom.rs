@@ -11,23 +11,26 @@ use std::io::{BufRead, BufReader, Lines};
 use std::path::{Path, PathBuf};
 
 use perception::pose::PoseFilter;
-use serde::Deserialize;
+use serde::{Deserialize, Serialize};
 
 /// One sample.
-#[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Deserialize, Serialize)]
 pub struct OdomRecord {
     /// Time, s, on the LiDAR's clock.
     pub t: f64,
     /// Left wheel ticks, cumulative.
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub left_ticks: Option<i64>,
     /// Right wheel ticks, cumulative.
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub right_ticks: Option<i64>,
     /// Magnetometer, robot frame, µT.
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub mag_ut: Option<[f32; 3]>,
 }
+
+/// Samples the pose state's journal holds between two recorded frames.
+pub const JOURNAL_LEN: usize = 64;
 
 /// Pose state of a run: the filter, and what went wrong.
 #[derive(Debug, Clone)]
@@ -38,6 +41,13 @@ pub struct PoseState {
     pub use_compass: bool,
     /// Bad odometry lines or samples.
     pub encoder_errors: u64,
+    /// While recording: every sample that became available to the pose (entered the queue, or
+    /// was read from the file) since the recorder last took them (full: the oldest are kept,
+    /// later ones counted in `journal_dropped`). Replay makes each available at the same frame,
+    /// so the poses come out the same.
+    pub journal: Option<heapless::Vec<OdomRecord, JOURNAL_LEN>>,
+    /// Samples that did not fit the journal (missing from the recording).
+    pub journal_dropped: u64,
     last_t: Option<f64>,
 }
 
@@ -48,6 +58,8 @@ impl PoseState {
             filter,
             use_compass,
             encoder_errors: 0,
+            journal: None,
+            journal_dropped: 0,
             last_t: None,
         }
     }
@@ -66,6 +78,15 @@ impl PoseState {
                 self.filter.interpolate(l as i32, r as i32, f)
             }
             _ => pose,
+        }
+    }
+
+    /// Notes that `r` became available (for the recording, when there is one).
+    pub fn note_available(&mut self, r: &OdomRecord) {
+        if let Some(j) = self.journal.as_mut()
+            && j.push(*r).is_err()
+        {
+            self.journal_dropped += 1;
         }
     }
 
@@ -141,7 +162,10 @@ impl OdomFile {
                         continue;
                     }
                     match serde_json::from_str::<OdomRecord>(&line) {
-                        Ok(r) => self.pending = Some(r),
+                        Ok(r) => {
+                            state.note_available(&r);
+                            self.pending = Some(r);
+                        }
                         Err(e) => {
                             if state.encoder_errors == 0 {
                                 log::warn!(

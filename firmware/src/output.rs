@@ -146,6 +146,10 @@ pub struct FaultsOut {
     /// Encoder/compass samples the device thread dropped because its queue was full (the
     /// loop stalled for seconds).
     pub odometry_dropped: u64,
+    /// LiDAR bytes missing from the `--record` file (the recorder was behind for too long).
+    pub recording_bytes_dropped: u64,
+    /// Odometry samples missing from the `--record` file.
+    pub recording_samples_dropped: u64,
     /// Frames that ended with the loop behind the LiDAR (more than a revolution of bytes
     /// queued, or the simulated sensor ahead by more than a revolution).
     pub behind_lidar: u64,

@@ -55,7 +55,7 @@ pub enum VizLink {}
 
 #[cfg(not(feature = "viz"))]
 impl VizLink {
-    fn send(&mut self, _fill: impl FnOnce(&mut VizFrameStub)) {
+    fn send(&mut self, _fill: impl FnOnce(&mut VizFrameStub)) -> bool {
         match *self {}
     }
     fn dropped(&self) -> u64 {
@@ -77,6 +77,8 @@ struct VizFrameStub {
     objects: heapless::Vec<ObjectOut, 1>,
     walls: heapless::Vec<WallOut, 1>,
     doors: heapless::Vec<DoorOut, 1>,
+    raw: heapless::Vec<u8, 1>,
+    odom: heapless::Vec<OdomRecord, 1>,
 }
 
 #[cfg(feature = "viz")]
@@ -189,7 +191,15 @@ struct FrameState {
     objects: Vec<ObjectOut>,
     walls: Vec<WallOut>,
     doors: Vec<DoorOut>,
+    /// While recording: the LiDAR bytes read since the last frame the recorder took.
+    pending_raw: Option<Box<heapless::Vec<u8, RECORD_RAW_BYTES>>>,
+    /// Bytes that did not fit `pending_raw` (missing from the recording).
+    raw_dropped: u64,
 }
+
+/// LiDAR bytes held for the recording between two recorded frames (16 KiB, over six LDS-01
+/// revolutions: room for a few frames the recorder had to drop).
+pub const RECORD_RAW_BYTES: usize = 16 * 1024;
 
 /// Output capacity reserved at start-up (so that the loop does not allocate).
 const OUT_CAPACITY: usize =
@@ -216,6 +226,10 @@ pub struct PoseInput {
     pub devices: Option<DeviceReader>,
     /// Host time → LiDAR time, for the device thread's samples.
     pub clock: ClockMap,
+    /// A recording's samples, each with the frame at which it became available
+    /// ([`crate::recording`]), read at start-up.
+    pub scheduled: Vec<(u64, OdomRecord)>,
+    scheduled_next: usize,
 }
 
 /// Reads the compass once; the error names the device. Runs on the device thread.
@@ -230,6 +244,8 @@ impl PoseInput {
             queue: VecDeque::with_capacity(POSE_QUEUE),
             devices: None,
             clock: ClockMap::default(),
+            scheduled: Vec::new(),
+            scheduled_next: 0,
         }
     }
 
@@ -237,24 +253,39 @@ impl PoseInput {
     /// (`start` is the run's host-clock origin). Before the first revolution maps the clocks
     /// a sample is stamped at `fallback`.
     fn take_device_samples(&mut self, start: Instant, fallback: f64) {
-        let Some(dev) = self.devices.as_ref() else {
-            return;
-        };
-        while let Some(s) = dev.try_next() {
+        while let Some(s) = self.devices.as_ref().and_then(DeviceReader::try_next) {
             let host_s = s.host.saturating_duration_since(start).as_secs_f64();
             let t = self.clock.sensor_time(host_s).unwrap_or(fallback);
-            if self.queue.len() >= self.queue.capacity() {
-                // Never grow: feed the oldest now (only if the loop stalled for seconds).
-                if let Some(r) = self.queue.pop_front() {
-                    self.state.feed(&r);
-                }
-            }
-            self.queue.push_back(OdomRecord {
+            let r = OdomRecord {
                 t,
                 left_ticks: s.ticks.map(|(l, _)| i64::from(l)),
                 right_ticks: s.ticks.map(|(_, r)| i64::from(r)),
                 mag_ut: s.mag_ut,
-            });
+            };
+            self.enqueue(r);
+        }
+    }
+
+    /// Puts a sample in the queue (never growing it: when full, the oldest is fed at once)
+    /// and notes it for the recording.
+    fn enqueue(&mut self, r: OdomRecord) {
+        if self.queue.len() >= self.queue.capacity()
+            && let Some(old) = self.queue.pop_front()
+        {
+            self.state.feed(&old);
+        }
+        self.state.note_available(&r);
+        self.queue.push_back(r);
+    }
+
+    /// Makes a recording's samples available at the frames they were in the recorded run.
+    fn take_scheduled(&mut self, frame: u64) {
+        while let Some(&(f, r)) = self.scheduled.get(self.scheduled_next) {
+            if f > frame {
+                break;
+            }
+            self.scheduled_next += 1;
+            self.enqueue(r);
         }
     }
 
@@ -369,7 +400,14 @@ pub fn run(
         objects: Vec::with_capacity(OUT_CAPACITY),
         walls: Vec::with_capacity(perception::walls::MAX_SEGMENTS),
         doors: Vec::with_capacity(perception::doors::MAX_DOORS),
+        pending_raw: opts.viz.is_some().then(|| Box::new(heapless::Vec::new())),
+        raw_dropped: 0,
     };
+    if opts.viz.is_some()
+        && let Some(p) = opts.pose.as_mut()
+    {
+        p.state.journal = Some(heapless::Vec::new());
+    }
 
     let mut watch = LinkWatch::default();
     let reason = 'outer: loop {
@@ -437,8 +475,25 @@ pub fn run(
         };
         summary.bytes += n as u64;
         watch.data();
+        if let Some(p) = state.pending_raw.as_mut() {
+            let take = n.min(p.capacity() - p.len());
+            let _ = p.extend_from_slice(&buf[..take]);
+            if take < n {
+                if state.raw_dropped == 0 {
+                    log::warn!(
+                        "recording: the recorder is behind; LiDAR bytes dropped from the recording (counted)"
+                    );
+                }
+                state.raw_dropped += (n - take) as u64;
+            }
+        }
         if let Some(p) = opts.pose.as_mut() {
+            let before = p.queue.len();
             source.drain_odometry(&mut p.queue);
+            for k in before..p.queue.len() {
+                let r = p.queue[k];
+                p.state.note_available(&r);
+            }
         }
         let mut input = &buf[..n.min(READ_CHUNK)];
         let now = (!source.is_file()).then(|| link_us(state.busy));
@@ -723,6 +778,7 @@ fn emit_frame(
     let t_end = t + period * 359.0 / 360.0;
     let (pose, end, encoder_errors, compass_rejected, compass_errors) = match opts.pose.as_mut() {
         Some(p) => {
+            p.take_scheduled(frame);
             p.take_device_samples(state.start, t);
             let start = p.advance(t);
             let end = p.advance(t_end);
@@ -892,6 +948,11 @@ fn emit_frame(
                 method_b_skipped: rec.method_b_skipped,
                 cloud_shrunk: rec.cloud_shrunk,
                 behind_lidar: rec.behind_lidar,
+                recording_bytes_dropped: state.raw_dropped,
+                recording_samples_dropped: opts
+                    .pose
+                    .as_ref()
+                    .map_or(0, |p| p.state.journal_dropped),
                 odometry_dropped: opts
                     .pose
                     .as_ref()
@@ -921,9 +982,19 @@ fn emit_frame(
         (None, Some(b)) => b.mount,
         (None, None) => Pose2::IDENTITY,
     };
+    let journal = opts.pose.as_mut().and_then(|p| p.state.journal.as_mut());
     if let Some(v) = opts.viz.as_mut() {
         let st = &*state;
-        v.send(|f: &mut VizFrameStub| {
+        let journal_ref = journal.as_deref();
+        let sent = v.send(|f: &mut VizFrameStub| {
+            f.raw.clear();
+            if let Some(raw) = st.pending_raw.as_deref() {
+                let _ = f.raw.extend_from_slice(raw);
+            }
+            f.odom.clear();
+            for r in journal_ref.into_iter().flatten() {
+                let _ = f.odom.push(*r);
+            }
             f.frame = frame;
             f.t = t;
             f.pose = pose;
@@ -942,6 +1013,14 @@ fn emit_frame(
                 let _ = f.doors.push(d.clone());
             }
         });
+        if sent {
+            if let Some(raw) = state.pending_raw.as_mut() {
+                raw.clear();
+            }
+            if let Some(j) = journal {
+                j.clear();
+            }
+        }
     }
     *ingest = Duration::ZERO;
     // Output errors end the run, so only this path needs the frame's time.

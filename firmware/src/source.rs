@@ -61,6 +61,16 @@ pub enum LidarSource {
         /// The model whose bytes it holds.
         model: LidarModel,
     },
+    /// LiDAR bytes held in memory: the raw channel of an MCAP recording
+    /// ([`crate::recording`]).
+    Recorded {
+        /// The recording's path, for messages.
+        path: PathBuf,
+        /// The bytes and the read position.
+        bytes: std::io::Cursor<Vec<u8>>,
+        /// The model whose bytes they are.
+        model: LidarModel,
+    },
     /// The built-in simulated robot.
     Sim {
         /// The simulator.
@@ -126,6 +136,44 @@ impl LidarSource {
         })
     }
 
+    #[cfg(feature = "viz")]
+    /// The LiDAR bytes of a recording, of `model` or (`None`) of the model the recording names,
+    /// else recognised from the bytes.
+    pub fn recorded(
+        rec: &mut crate::recording::Recording,
+        model: Option<LidarModel>,
+    ) -> Result<(Self, String), String> {
+        let shown = rec.path.display().to_string();
+        let (model, how) = match (model, rec.model) {
+            (Some(m), _) => (m, format!("{m} named")),
+            (None, Some(m)) => (m, format!("{m}, as the recording says")),
+            (None, None) => {
+                let mut det = Detector::new();
+                det.feed(&rec.bytes[..rec.bytes.len().min(DETECT_BYTES)]);
+                let verdict = det.verdict();
+                let words = drivers::probe::describe(&verdict);
+                match verdict {
+                    Verdict::Found { model, .. } | Verdict::HighErrorRate { model, .. } => {
+                        (model, format!("recognised: {words}"))
+                    }
+                    _ => {
+                        return Err(format!(
+                            "recording {shown}: no LiDAR recognised in its bytes: {words}"
+                        ));
+                    }
+                }
+            }
+        };
+        Ok((
+            LidarSource::Recorded {
+                path: rec.path.clone(),
+                bytes: std::io::Cursor::new(std::mem::take(&mut rec.bytes)),
+                model,
+            },
+            how,
+        ))
+    }
+
     /// Opens a raw capture file of `model`, or (`None`) recognises the model from its first
     /// [`DETECT_BYTES`] bytes. A file in which no model's frames are found is an error.
     pub fn capture(path: &Path, model: Option<LidarModel>) -> Result<(Self, String), String> {
@@ -184,7 +232,7 @@ impl LidarSource {
     pub fn model(&self) -> LidarModel {
         match self {
             LidarSource::Serial { model, .. } => *model,
-            LidarSource::Capture { model, .. } => *model,
+            LidarSource::Capture { model, .. } | LidarSource::Recorded { model, .. } => *model,
             LidarSource::Sim { .. } => LidarModel::Lds01,
         }
     }
@@ -206,6 +254,22 @@ impl LidarSource {
             room_seed,
             calibration,
         }
+    }
+
+    /// What a recording says of this source, for replay: `model` (its `--lidar-model` name),
+    /// `source` (this source's description) and, for the simulator, its compass calibration
+    /// (`compass_calibration`: hard iron x, y, field horizontal, vertical, µT).
+    pub fn recording_meta(&self) -> std::collections::BTreeMap<String, String> {
+        let mut m = std::collections::BTreeMap::new();
+        m.insert("model".into(), self.model().cli_name().into());
+        m.insert("source".into(), self.describe());
+        if let Some((h, f)) = self.sim_calibration() {
+            m.insert(
+                "compass_calibration".into(),
+                format!("{} {} {} {}", h[0], h[1], f[0], f[1]),
+            );
+        }
+        m
     }
 
     /// The calibration (hard iron, field reference) of the simulated compass, if this is the
@@ -240,6 +304,9 @@ impl LidarSource {
             LidarSource::Capture { path, model, .. } => {
                 format!("raw {model} capture {}", path.display())
             }
+            LidarSource::Recorded { path, model, .. } => {
+                format!("{model} bytes recorded in {}", path.display())
+            }
             LidarSource::Sim { sim, room_seed, .. } => format!(
                 "no hardware named: running on the built-in simulated robot (LDS-01; seed {room_seed}: {})",
                 sim.world().describe()
@@ -255,7 +322,10 @@ impl LidarSource {
 
     /// A capture file: bytes with no timing of their own (no silence, so no staleness).
     pub fn is_file(&self) -> bool {
-        matches!(self, LidarSource::Capture { .. })
+        matches!(
+            self,
+            LidarSource::Capture { .. } | LidarSource::Recorded { .. }
+        )
     }
 
     /// Bytes from a serial port not yet decoded: queued by the reader thread plus waiting in
@@ -309,6 +379,13 @@ impl LidarSource {
                 Err(e) if e.kind() == std::io::ErrorKind::Interrupted => SourceRead::Idle,
                 Err(e) => SourceRead::Lost(format!("capture {}: read error: {e}", path.display())),
             },
+            LidarSource::Recorded { bytes, .. } => {
+                use std::io::Read as _;
+                match bytes.read(buf) {
+                    Ok(0) | Err(_) => SourceRead::End,
+                    Ok(n) => SourceRead::Data(n),
+                }
+            }
             LidarSource::Sim { sim, .. } => {
                 let mut n = 0;
                 for chunk in buf.chunks_exact_mut(PACKET_LEN).take(SIM_PACKETS_PER_READ) {

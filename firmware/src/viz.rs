@@ -8,7 +8,13 @@
 //!   `base_link → lidar` (the mount);
 //! * `/pose` `foxglove.PoseInFrame` in `map`;
 //! * `/perception` `foxglove.SceneUpdate` in `map`: objects (a cube coloured by class and a
-//!   label `class score source`), walls (a line list), doors (a thin cube).
+//!   label `class score source`), walls (a line list), doors (a thin cube);
+//! * for replay (`umbra replay RUN.mcap`, [`crate::recording`]): `/umbra/lidar_raw`, the LiDAR's
+//!   bytes exactly as read (message encoding `application/octet-stream`, no schema; channel
+//!   metadata names the model and, for the simulated robot, its compass calibration), and
+//!   `/umbra/odometry`, every encoder/compass sample as the `--odom` JSON object of
+//!   `interfaces.md` §2 plus the frame at which it became available to the pose (encoding
+//!   `json`, a JSON Schema).
 //!
 //! The frame loop never allocates for this: it fills a [`VizFrame`] taken from a pool of
 //! boxes made at start-up and hands it to the viz thread through a bounded channel; the thread
@@ -26,11 +32,24 @@ use foxglove::schemas::{
     PoseInFrame, Quaternion, SceneEntity, SceneUpdate, TextPrimitive, Timestamp, Vector3,
     line_primitive,
 };
-use foxglove::{Channel, ChannelBuilder, Context};
+use foxglove::{Channel, ChannelBuilder, Context, RawChannel, Schema};
 use perception::geometry::Pose2;
 use perception::raster::SCAN_COLUMNS;
 
+use crate::odom::OdomRecord;
 use crate::output::{DoorOut, ObjectOut, WallOut};
+
+/// LiDAR bytes a frame carries to the recording: 16 KiB, over six LDS-01 revolutions, so a
+/// frame's bytes fit even when the viz thread was behind for a few frames.
+pub const RAW_BYTES: usize = crate::runner::RECORD_RAW_BYTES;
+/// Encoder/compass samples a frame carries to the recording (20 Hz: 4 a frame).
+pub const VIZ_ODOM: usize = crate::odom::JOURNAL_LEN;
+/// Topic of the LiDAR's raw bytes.
+pub const RAW_TOPIC: &str = "/umbra/lidar_raw";
+/// Topic of the odometry samples.
+pub const ODOM_TOPIC: &str = "/umbra/odometry";
+/// Message encoding of the raw bytes.
+pub const RAW_ENCODING: &str = "application/octet-stream";
 
 /// Objects a frame carries to the viz thread.
 pub const VIZ_OBJECTS: usize = 64;
@@ -60,6 +79,10 @@ pub struct VizFrame {
     pub walls: heapless::Vec<WallOut, VIZ_WALLS>,
     /// Doors.
     pub doors: heapless::Vec<DoorOut, VIZ_DOORS>,
+    /// LiDAR bytes read since the last frame recorded.
+    pub raw: heapless::Vec<u8, RAW_BYTES>,
+    /// Samples fed to the pose filter since the last frame recorded.
+    pub odom: heapless::Vec<OdomRecord, VIZ_ODOM>,
 }
 
 impl Default for VizFrame {
@@ -73,6 +96,8 @@ impl Default for VizFrame {
             objects: heapless::Vec::new(),
             walls: heapless::Vec::new(),
             doors: heapless::Vec::new(),
+            raw: heapless::Vec::new(),
+            odom: heapless::Vec::new(),
         }
     }
 }
@@ -84,6 +109,9 @@ pub struct VizTargets {
     pub record: Option<PathBuf>,
     /// Address to serve the live view on.
     pub live: Option<SocketAddr>,
+    /// What the source is (`model`, `source`, and the simulated compass's calibration),
+    /// written as the raw channel's metadata for replay.
+    pub meta: std::collections::BTreeMap<String, String>,
 }
 
 /// The loop's end of the viz thread.
@@ -132,7 +160,7 @@ impl VizLink {
             }
             None => (None, None),
         };
-        let channels = Channels::new(&ctx);
+        let channels = Channels::new(&ctx, &targets.meta)?;
         let (to_thread, from_loop) = sync_channel::<Box<VizFrame>>(VIZ_POOL);
         let (to_pool, pool) = sync_channel::<Box<VizFrame>>(VIZ_POOL);
         for _ in 0..VIZ_POOL {
@@ -172,17 +200,22 @@ impl VizLink {
     }
 
     /// Hands one frame to the viz thread: `fill` writes it into a pooled box. Without a free
-    /// box (the thread is behind) the frame is dropped and counted. Allocates nothing.
-    pub fn send(&mut self, fill: impl FnOnce(&mut VizFrame)) {
+    /// box (the thread is behind) the frame is dropped and counted, and `false` returned (the
+    /// caller keeps its raw bytes for the next frame). Allocates nothing.
+    pub fn send(&mut self, fill: impl FnOnce(&mut VizFrame)) -> bool {
         let Ok(mut frame) = self.pool.try_recv() else {
             self.dropped += 1;
-            return;
+            return false;
         };
         fill(&mut frame);
         match self.to_thread.as_ref().map(|tx| tx.try_send(frame)) {
-            Some(Ok(())) => self.sent += 1,
+            Some(Ok(())) => {
+                self.sent += 1;
+                true
+            }
             Some(Err(TrySendError::Full(_) | TrySendError::Disconnected(_))) | None => {
-                self.dropped += 1
+                self.dropped += 1;
+                false
             }
         }
     }
@@ -222,7 +255,23 @@ struct Channels {
     tf: Channel<FrameTransforms>,
     pose: Channel<PoseInFrame>,
     scene: Channel<SceneUpdate>,
+    raw: Arc<RawChannel>,
+    odom: Arc<RawChannel>,
 }
+
+/// An `/umbra/odometry` message: the `--odom` object of `interfaces.md` §2 plus the frame at
+/// which the sample became available to the pose (replay makes it available at that frame).
+#[derive(Debug, Clone, Copy, serde::Serialize, serde::Deserialize)]
+pub struct RecordedSample {
+    /// The frame.
+    pub frame: u64,
+    /// The sample.
+    #[serde(flatten)]
+    pub sample: OdomRecord,
+}
+
+/// The JSON Schema of an `/umbra/odometry` message (the `--odom` line of `interfaces.md` §2).
+const ODOM_SCHEMA: &str = r#"{"type":"object","required":["t","frame"],"properties":{"frame":{"type":"integer"},"t":{"type":"number"},"left_ticks":{"type":["integer","null"]},"right_ticks":{"type":["integer","null"]},"mag_ut":{"type":["array","null"],"items":{"type":"number"},"minItems":3,"maxItems":3}}}"#;
 
 fn ts(t: f64) -> Option<Timestamp> {
     Some(Timestamp::saturating_from_epoch_secs_f64(t.max(0.0)))
@@ -257,16 +306,50 @@ fn colour(class: &str) -> Color {
 }
 
 impl Channels {
-    fn new(ctx: &Arc<Context>) -> Self {
-        Channels {
+    fn new(
+        ctx: &Arc<Context>,
+        meta: &std::collections::BTreeMap<String, String>,
+    ) -> Result<Self, String> {
+        let raw = ChannelBuilder::new(RAW_TOPIC)
+            .context(ctx)
+            .message_encoding(RAW_ENCODING)
+            .metadata(meta.clone())
+            .build_raw()
+            .map_err(|e| format!("{RAW_TOPIC}: {e}"))?;
+        let odom = ChannelBuilder::new(ODOM_TOPIC)
+            .context(ctx)
+            .message_encoding("json")
+            .schema(Schema::new(
+                "umbra.Odometry",
+                "jsonschema",
+                ODOM_SCHEMA.as_bytes().to_vec(),
+            ))
+            .build_raw()
+            .map_err(|e| format!("{ODOM_TOPIC}: {e}"))?;
+        Ok(Channels {
             scan: ChannelBuilder::new("/scan").context(ctx).build(),
             tf: ChannelBuilder::new("/tf").context(ctx).build(),
             pose: ChannelBuilder::new("/pose").context(ctx).build(),
             scene: ChannelBuilder::new("/perception").context(ctx).build(),
-        }
+            raw,
+            odom,
+        })
     }
 
     fn log(&self, f: &VizFrame) {
+        // Replay inputs first: the samples and bytes that made this frame.
+        for r in &f.odom {
+            let msg = RecordedSample {
+                frame: f.frame,
+                sample: *r,
+            };
+            if let Ok(json) = serde_json::to_vec(&msg) {
+                self.odom.log(&json);
+            }
+        }
+        if !f.raw.is_empty() {
+            self.raw.log(&f.raw);
+        }
         let stamp = ts(f.t);
         self.scan.log(&LaserScan {
             timestamp: stamp,

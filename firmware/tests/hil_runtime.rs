@@ -221,7 +221,10 @@ fn opencr(link: PathBuf, first: TTYPort, t0: Instant, done: Arc<AtomicBool>) -> 
     let mut unplugged = false;
     while !done.load(Ordering::Relaxed) {
         if !unplugged && t0.elapsed() > Duration::from_millis(3000) {
-            drop(std::mem::replace(&mut master, plug(&link.with_extension("void"))));
+            drop(std::mem::replace(
+                &mut master,
+                plug(&link.with_extension("void")),
+            ));
             thread::sleep(Duration::from_millis(500));
             master = plug(&link);
             dec = StatusDecoder::new();
@@ -308,9 +311,15 @@ fn whole_runtime_survives_garbage_a_stalled_motor_and_unplugs_and_reports_them()
         stderr.contains("| total | 18 |") && stderr.contains("power: mean"),
         "the run ends with its report"
     );
-    assert!(log.restarted_after_replug, "the motor was restarted after the replug");
+    assert!(
+        log.restarted_after_replug,
+        "the motor was restarted after the replug"
+    );
     assert!(stopped, "the motor was stopped (`e`) on exit");
-    assert!(stderr.contains("stalled"), "the stall was reported in the log");
+    assert!(
+        stderr.contains("stalled"),
+        "the stall was reported in the log"
+    );
     assert!(answered > 20, "the OpenCR was polled");
 
     let lines: Vec<serde_json::Value> = std::fs::read_to_string(&jsonl)
@@ -323,7 +332,10 @@ fn whole_runtime_survives_garbage_a_stalled_motor_and_unplugs_and_reports_them()
     println!("last faults: {last}");
     let count = |k: &str| last[k].as_u64().unwrap_or_else(|| panic!("faults.{k}"));
     assert!(count("lidar_bytes_skipped") > 0, "garbage counted");
-    assert!(count("lidar_stalled_packets") > 100, "stalled packets counted");
+    assert!(
+        count("lidar_stalled_packets") > 100,
+        "stalled packets counted"
+    );
     assert!(count("lidar_link_lost") >= 1, "the unplug counted");
     assert!(count("lidar_link_reopened") >= 1, "the replug counted");
     assert!(count("encoder_errors") >= 1, "the OpenCR unplug counted");
@@ -359,6 +371,9 @@ fn whole_runtime_survives_garbage_a_stalled_motor_and_unplugs_and_reports_them()
         (speed - want).abs() < 0.25 * want,
         "speed {speed} vs {want}"
     );
-    assert!(yb.abs() < 0.02 && thb.abs() < 0.02, "straight: y {yb}, θ {thb}");
+    assert!(
+        yb.abs() < 0.02 && thb.abs() < 0.02,
+        "straight: y {yb}, θ {thb}"
+    );
     let _ = std::fs::remove_dir_all(&dir);
 }

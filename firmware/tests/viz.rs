@@ -37,11 +37,20 @@ fn record_writes_an_mcap_that_reads_back_and_a_snapshot() {
     let bytes = std::fs::read(&rec).unwrap();
     let mut per_topic: BTreeMap<String, usize> = BTreeMap::new();
     let mut schemas: BTreeMap<String, String> = BTreeMap::new();
+    let mut raw_meta = BTreeMap::new();
     for m in mcap::MessageStream::new(&bytes).expect("an MCAP file") {
         let m = m.expect("a readable message");
         *per_topic.entry(m.channel.topic.clone()).or_default() += 1;
-        let schema = m.channel.schema.as_ref().expect("a schema");
-        schemas.insert(m.channel.topic.clone(), schema.name.clone());
+        let schema = m
+            .channel
+            .schema
+            .as_ref()
+            .map_or("(none)".to_owned(), |s| s.name.clone());
+        schemas.insert(m.channel.topic.clone(), schema);
+        if m.channel.topic == "/umbra/lidar_raw" {
+            assert_eq!(m.channel.message_encoding, "application/octet-stream");
+            raw_meta = m.channel.metadata.clone();
+        }
         assert!(!m.data.is_empty());
     }
     let want: BTreeMap<String, String> = [
@@ -49,14 +58,20 @@ fn record_writes_an_mcap_that_reads_back_and_a_snapshot() {
         ("/tf", "foxglove.FrameTransforms"),
         ("/pose", "foxglove.PoseInFrame"),
         ("/perception", "foxglove.SceneUpdate"),
+        ("/umbra/lidar_raw", "(none)"),
+        ("/umbra/odometry", "umbra.Odometry"),
     ]
     .into_iter()
     .map(|(a, b)| (a.to_owned(), b.to_owned()))
     .collect();
     assert_eq!(schemas, want);
-    for (topic, n) in &per_topic {
-        assert_eq!(*n, 12, "{topic}: one message a frame");
+    for topic in ["/scan", "/tf", "/pose", "/perception", "/umbra/lidar_raw"] {
+        assert_eq!(per_topic[topic], 12, "{topic}: one message a frame");
     }
+    // The simulator's encoders and compass at 20 Hz: ~4 samples a 0.2 s frame.
+    assert!(per_topic["/umbra/odometry"] >= 40, "{per_topic:?}");
+    assert_eq!(raw_meta.get("model").map(String::as_str), Some("lds01"));
+    assert!(raw_meta.contains_key("compass_calibration"));
     let s = std::fs::read_to_string(&svg).unwrap();
     assert!(s.starts_with("<svg"));
     for id in ["cloud", "walls", "objects", "robot"] {

@@ -117,11 +117,12 @@ fn with_method_b_only_tract_allocates_and_a_constant_amount() {
 #[test]
 fn recording_costs_the_loop_no_allocation() {
     // The viz thread converts and writes (and allocates) on its own; the loop only fills
-    // pooled frames.
+    // pooled frames (results, the raw LiDAR bytes and the odometry samples for replay).
     let path = std::env::temp_dir().join(format!("umbra-alloc-{}.mcap", std::process::id()));
     let link = runner::VizLink::start(&firmware::viz::VizTargets {
         record: Some(path.clone()),
         live: None,
+        meta: Default::default(),
     })
     .expect("recorder");
     let d = per_frame_with(false, Some(link));

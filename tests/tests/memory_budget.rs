@@ -164,6 +164,16 @@ fn buffers_in_code() -> Vec<(&'static str, usize, usize)> {
             size_of::<firmware::viz::VizFrame>(),
         ),
         (
+            "firmware::runner::RECORD_RAW_BYTES",
+            firmware::runner::RECORD_RAW_BYTES,
+            1,
+        ),
+        (
+            "firmware::odom::JOURNAL_LEN",
+            firmware::odom::JOURNAL_LEN,
+            size_of::<firmware::odom::OdomRecord>(),
+        ),
+        (
             "firmware::reader::CHUNK_POOL",
             firmware::reader::CHUNK_POOL,
             size_of::<firmware::reader::Chunk>(),
