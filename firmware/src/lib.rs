@@ -22,6 +22,7 @@
 #![deny(unsafe_code, missing_docs)]
 
 pub mod calibrate;
+pub mod carmen;
 pub mod cli;
 pub mod config;
 pub mod confusion_png;
@@ -29,6 +30,7 @@ pub mod deadline;
 pub mod eval_a;
 #[cfg(feature = "method-b")]
 pub mod eval_b;
+pub mod frames;
 pub mod odom;
 pub mod output;
 pub mod power;

@@ -220,6 +220,15 @@ fn dispatch(cli: Cli) -> Result<(), Failure> {
             let named = named_model(args.common.lidar_model);
             let (mut source, how, recorded) = open_replay(&args.capture, named)?;
             log::info!("LiDAR: {how}");
+            if source.model().is_none() && args.odom.is_some() {
+                return Err((
+                    EXIT_USAGE,
+                    format!(
+                        "--odom: {} is a CARMEN log, which carries its own odometry",
+                        args.capture.display()
+                    ),
+                ));
+            }
             println!("umbra: {}", source.describe());
             let pose = match (&args.odom, recorded) {
                 (None, Some((samples, bad, cal))) => {
@@ -247,6 +256,10 @@ fn dispatch(cli: Cli) -> Result<(), Failure> {
                     let mut p = PoseInput::new(PoseState::new(cfg.pose_filter(None), use_compass));
                     p.file = Some(file);
                     Some(p)
+                }
+                // A log's odometry comes from its own lines, through the frame loop.
+                (None, None) if source.model().is_none() => {
+                    Some(PoseInput::new(PoseState::new(cfg.pose_filter(None), false)))
                 }
                 (None, None) => None,
             };
@@ -286,7 +299,11 @@ fn open_replay(
             log::info!("recording of: {s}");
         }
         let (source, how) = LidarSource::recorded(&mut rec, named).map_err(|m| (EXIT_USAGE, m))?;
-        let odometry = std::mem::take(&mut rec.odometry);
+        let mut odometry = std::mem::take(&mut rec.odometry);
+        if source.model().is_none() {
+            // A log's odometry lines are in the recorded text: the log reader makes them again.
+            odometry.clear();
+        }
         let recorded =
             (!odometry.is_empty()).then_some((odometry, rec.bad_odometry, rec.compass_calibration));
         return Ok((source, how, recorded));
@@ -298,8 +315,39 @@ fn open_replay(
             path.display()
         );
     }
+    if named.is_none() && is_carmen(path) {
+        let text = firmware::carmen::read_log(path).map_err(|m| (EXIT_USAGE, m))?;
+        let source = LidarSource::log(path, text);
+        return Ok((
+            source,
+            "a CARMEN log (FLASER scans, ODOM poses)".into(),
+            None,
+        ));
+    }
     let (source, how) = LidarSource::capture(path, named).map_err(|m| (EXIT_USAGE, m))?;
     Ok((source, how, None))
+}
+
+/// Whether `path` holds a CARMEN log (gzip-compressed or not), from its first bytes.
+fn is_carmen(path: &std::path::Path) -> bool {
+    use std::io::Read as _;
+    let Ok(file) = File::open(path) else {
+        return false;
+    };
+    let mut head = Vec::with_capacity(4096);
+    let mut raw = [0u8; 2];
+    let gz = File::open(path)
+        .and_then(|mut f| f.read_exact(&mut raw))
+        .is_ok()
+        && raw == [0x1F, 0x8B];
+    let read = if gz {
+        flate2::read::MultiGzDecoder::new(file)
+            .take(4096)
+            .read_to_end(&mut head)
+    } else {
+        file.take(4096).read_to_end(&mut head)
+    };
+    read.is_ok() && firmware::carmen::looks_like_carmen(&head)
 }
 
 /// Opens an LSM303AGR on the I²C bus at `bus` (e.g. `/dev/i2c-1`); a failure is reported once
@@ -381,7 +429,17 @@ fn run_loop(
     if let Err(e) = ctrlc::set_handler(move || flag.store(true, Ordering::Relaxed)) {
         log::warn!("cannot install the Ctrl-C handler ({e}); Ctrl-C will stop without a summary");
     }
-    let method_b = load_method_b(cfg, common)?;
+    let mount = source.mount().unwrap_or_else(|| cfg.lidar_mount());
+    if let Some(m) = source.mount() {
+        log::info!(
+            "laser mount from the log: {:.3} m forward of the robot's centre",
+            m.x
+        );
+    }
+    let mut method_b = load_method_b(cfg, common)?;
+    if let Some(b) = method_b.as_mut() {
+        b.mount = mount;
+    }
     let power = PowerMeter::start(&cfg.power).map_err(|e| (EXIT_USAGE, e))?;
     log::info!("power: {}", power.source());
     let viz = start_viz(common, source)?;
@@ -400,17 +458,32 @@ fn run_loop(
         stats,
         stop,
         pose,
-        method_a: cfg
-            .method_a
-            .enabled
-            .then(|| (cfg.method_a(), cfg.lidar_mount())),
+        method_a: cfg.method_a.enabled.then(|| (cfg.method_a(), mount)),
         method_b,
         viz,
         snapshot: common.snapshot.clone(),
     };
-    let stream = drivers::lidar::AnyLidar::new(source.model(), &cfg.lidar());
-    let summary = runner::run(source, stream, opts)
-        .map_err(|e| (EXIT_FAULT, format!("cannot write output: {e}")))?;
+    let summary = match source.model() {
+        Some(model) => {
+            let stream = drivers::lidar::AnyLidar::new(model, &cfg.lidar());
+            runner::run(source, stream, opts)
+        }
+        None => {
+            let window = cfg.lidar();
+            let o = &cfg.odometry;
+            let stream = firmware::carmen::CarmenStream::new(
+                window.min_range_m.unwrap_or(0.12),
+                window.max_range_m.unwrap_or(3.5),
+                perception::pose::OdometryConfig {
+                    wheel_radius_m: o.wheel_radius_m,
+                    wheel_separation_m: o.wheel_separation_m,
+                    ticks_per_rev: o.ticks_per_rev,
+                },
+            );
+            runner::run(source, stream, opts)
+        }
+    }
+    .map_err(|e| (EXIT_FAULT, format!("cannot write output: {e}")))?;
     print_summary(&summary);
     Ok(())
 }

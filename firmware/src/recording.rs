@@ -25,6 +25,8 @@ pub struct Recording {
     pub model: Option<LidarModel>,
     /// What the source was, as the recording run described it.
     pub source: Option<String>,
+    /// `carmen` when the recorded bytes are a CARMEN log's text, not a LiDAR's.
+    pub format: Option<String>,
     /// The simulated compass's calibration (hard iron, field reference), if recorded.
     pub compass_calibration: Option<([f32; 2], [f32; 2])>,
     /// The LiDAR's bytes, in the order read.
@@ -54,6 +56,7 @@ pub fn read(path: &Path) -> Result<Recording, String> {
         path: path.to_owned(),
         model: None,
         source: None,
+        format: None,
         compass_calibration: None,
         bytes: Vec::new(),
         odometry: Vec::new(),
@@ -85,6 +88,7 @@ pub fn read(path: &Path) -> Result<Recording, String> {
                         .get("model")
                         .and_then(|n| LidarModel::ALL.into_iter().find(|m| m.cli_name() == n));
                     rec.source = meta.get("source").cloned();
+                    rec.format = meta.get("format").cloned();
                     rec.compass_calibration = meta
                         .get("compass_calibration")
                         .and_then(|s| parse_calibration(s));

@@ -18,7 +18,9 @@ use std::time::{Duration, Instant};
 
 use std::collections::VecDeque;
 
-use drivers::lidar::{AnyLidar, LidarFaults, LidarStream};
+use drivers::lidar::LidarFaults;
+
+use crate::frames::FrameStream;
 use perception::cloud::Scan;
 use perception::geometry::{Point2, Pose2};
 use perception::method_a::{MethodA, MethodAConfig};
@@ -370,9 +372,9 @@ impl Summary {
 }
 
 /// Runs the loop until a limit, the end of the source, or the stop flag.
-pub fn run(
+pub fn run<S: FrameStream>(
     source: &mut LidarSource,
-    mut stream: AnyLidar,
+    mut stream: S,
     mut opts: RunOptions,
 ) -> Result<Summary, std::io::Error> {
     let mut buf = [0u8; READ_CHUNK];
@@ -501,6 +503,15 @@ pub fn run(
             let t_feed = Instant::now();
             let done = stream.next_revolution(&mut input, now);
             ingest += t_feed.elapsed();
+            if let Some(p) = opts.pose.as_mut() {
+                // A log's odometry lines, up to the frame's scan.
+                let before = p.queue.len();
+                stream.drain_odometry(&mut p.queue);
+                for k in before..p.queue.len() {
+                    let r = p.queue[k];
+                    p.state.note_available(&r);
+                }
+            }
             if !done {
                 break;
             }
@@ -604,18 +615,18 @@ impl LinkWatch {
         }
     }
 
-    fn idle(&mut self, source: &LidarSource, stream: &AnyLidar) {
+    fn idle(&mut self, source: &LidarSource, stream: &impl FrameStream) {
         let since = self.last_data.get_or_insert_with(Instant::now).elapsed();
         if !self.silent && !source.is_file() && since.as_secs_f64() > SILENT_WARN_S {
             log::warn!(
                 "no bytes from the LiDAR for {SILENT_WARN_S} s ({}): unplugged, unpowered or not spinning? Frames resume when it speaks",
-                stream.model()
+                stream.what()
             );
             self.silent = true;
         }
     }
 
-    fn after_feed(&mut self, stream: &AnyLidar, frames: u64) {
+    fn after_feed(&mut self, stream: &impl FrameStream, frames: u64) {
         let stalled = stream.faults().stalled_packets;
         if stalled > self.stalled_seen {
             if !self.stalled {
@@ -639,12 +650,14 @@ fn behind_lidar(
     source: &LidarSource,
     backlog_bytes: Option<u32>,
     pacing: Pacing,
-    stream: &AnyLidar,
+    stream: &impl FrameStream,
     start: &Instant,
     period_s: f64,
 ) -> bool {
     if let Some(queued) = backlog_bytes {
-        return queued > stream.model().bytes_per_revolution();
+        return stream
+            .bytes_per_revolution()
+            .is_some_and(|per_rev| queued > per_rev);
     }
     source.is_simulated()
         && pacing == Pacing::RealTime
@@ -743,7 +756,7 @@ fn method_b_frame(b: &mut MethodBSetup, state: &mut FrameState) -> Result<(), St
 /// Writes the stream's last finished revolution as one frame; returns `true` when the frame
 /// limit is reached.
 fn emit_frame(
-    stream: &AnyLidar,
+    stream: &impl FrameStream,
     source: &LidarSource,
     opts: &mut RunOptions,
     summary: &mut Summary,

@@ -71,6 +71,15 @@ pub enum LidarSource {
         /// The model whose bytes they are.
         model: LidarModel,
     },
+    /// A CARMEN log's text, read (and gunzipped) at start-up ([`crate::carmen`]).
+    Log {
+        /// The log's path, for messages.
+        path: PathBuf,
+        /// The text and the read position.
+        text: std::io::Cursor<Vec<u8>>,
+        /// The laser's offset forward of the robot's centre (`robot_frontlaser_offset`), m.
+        laser_offset_m: Option<f32>,
+    },
     /// The built-in simulated robot.
     Sim {
         /// The simulator.
@@ -144,6 +153,13 @@ impl LidarSource {
         model: Option<LidarModel>,
     ) -> Result<(Self, String), String> {
         let shown = rec.path.display().to_string();
+        if rec.format.as_deref() == Some("carmen") {
+            let text = std::mem::take(&mut rec.bytes);
+            return Ok((
+                LidarSource::log(&rec.path, text),
+                "a CARMEN log's text, as the recording says".into(),
+            ));
+        }
         let (model, how) = match (model, rec.model) {
             (Some(m), _) => (m, format!("{m} named")),
             (None, Some(m)) => (m, format!("{m}, as the recording says")),
@@ -228,12 +244,36 @@ impl LidarSource {
         ))
     }
 
-    /// The model whose bytes this source gives.
-    pub fn model(&self) -> LidarModel {
+    /// The model whose bytes this source gives (`None`: a log, not a LiDAR's bytes).
+    pub fn model(&self) -> Option<LidarModel> {
         match self {
-            LidarSource::Serial { model, .. } => *model,
-            LidarSource::Capture { model, .. } | LidarSource::Recorded { model, .. } => *model,
-            LidarSource::Sim { .. } => LidarModel::Lds01,
+            LidarSource::Serial { model, .. } => Some(*model),
+            LidarSource::Capture { model, .. } | LidarSource::Recorded { model, .. } => {
+                Some(*model)
+            }
+            LidarSource::Log { .. } => None,
+            LidarSource::Sim { .. } => Some(LidarModel::Lds01),
+        }
+    }
+
+    /// A CARMEN log (its text in memory).
+    pub fn log(path: &Path, text: Vec<u8>) -> Self {
+        LidarSource::Log {
+            path: path.to_owned(),
+            laser_offset_m: crate::carmen::front_laser_offset(&text),
+            text: std::io::Cursor::new(text),
+        }
+    }
+
+    /// Where the laser sits on the robot when the source says so (a CARMEN log's
+    /// `robot_frontlaser_offset`); `None`: the configuration's mount.
+    pub fn mount(&self) -> Option<perception::geometry::Pose2> {
+        match self {
+            LidarSource::Log {
+                laser_offset_m: Some(x),
+                ..
+            } => Some(perception::geometry::Pose2::new(*x, 0.0, 0.0)),
+            _ => None,
         }
     }
 
@@ -261,7 +301,10 @@ impl LidarSource {
     /// (`compass_calibration`: hard iron x, y, field horizontal, vertical, µT).
     pub fn recording_meta(&self) -> std::collections::BTreeMap<String, String> {
         let mut m = std::collections::BTreeMap::new();
-        m.insert("model".into(), self.model().cli_name().into());
+        match self.model() {
+            Some(model) => m.insert("model".into(), model.cli_name().into()),
+            None => m.insert("format".into(), "carmen".into()),
+        };
         m.insert("source".into(), self.describe());
         if let Some((h, f)) = self.sim_calibration() {
             m.insert(
@@ -307,6 +350,7 @@ impl LidarSource {
             LidarSource::Recorded { path, model, .. } => {
                 format!("{model} bytes recorded in {}", path.display())
             }
+            LidarSource::Log { path, .. } => format!("CARMEN log {}", path.display()),
             LidarSource::Sim { sim, room_seed, .. } => format!(
                 "no hardware named: running on the built-in simulated robot (LDS-01; seed {room_seed}: {})",
                 sim.world().describe()
@@ -324,7 +368,7 @@ impl LidarSource {
     pub fn is_file(&self) -> bool {
         matches!(
             self,
-            LidarSource::Capture { .. } | LidarSource::Recorded { .. }
+            LidarSource::Capture { .. } | LidarSource::Recorded { .. } | LidarSource::Log { .. }
         )
     }
 
@@ -379,7 +423,7 @@ impl LidarSource {
                 Err(e) if e.kind() == std::io::ErrorKind::Interrupted => SourceRead::Idle,
                 Err(e) => SourceRead::Lost(format!("capture {}: read error: {e}", path.display())),
             },
-            LidarSource::Recorded { bytes, .. } => {
+            LidarSource::Recorded { bytes, .. } | LidarSource::Log { text: bytes, .. } => {
                 use std::io::Read as _;
                 match bytes.read(buf) {
                     Ok(0) | Err(_) => SourceRead::End,

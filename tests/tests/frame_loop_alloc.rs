@@ -83,7 +83,7 @@ fn per_frame_from(
         snapshot: None,
     };
     let mut summary = None;
-    let stream = drivers::lidar::AnyLidar::new(source.model(), &cfg.lidar());
+    let stream = drivers::lidar::AnyLidar::new(source.model().expect("a LiDAR"), &cfg.lidar());
     counted(|| summary = Some(runner::run(&mut source, stream, opts).expect("run")));
     let summary = summary.unwrap();
     assert_eq!(summary.frames, FRAMES);
