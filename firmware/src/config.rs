@@ -10,6 +10,8 @@
 //!
 //! [runtime]
 //! deadline_ms = 250        # per-frame budget
+//! scheduling = "normal"    # or "fifo": the frame loop real-time (needs CAP_SYS_NICE)
+//! fifo_priority = 20       # 1–99, with "fifo"
 //!
 //! [runtime.budget_ms]      # per-stage budgets; each defaults to a share of the deadline
 //! ingest = 10              # 4 %
@@ -124,6 +126,10 @@ pub struct RuntimeSettings {
     pub deadline_ms: f64,
     /// Per-stage budgets.
     pub budget_ms: StageBudgets,
+    /// How the frame loop's thread is scheduled.
+    pub scheduling: Scheduling,
+    /// Its `SCHED_FIFO` priority (1–99) when `scheduling = "fifo"`.
+    pub fifo_priority: u8,
 }
 
 impl Default for RuntimeSettings {
@@ -131,8 +137,24 @@ impl Default for RuntimeSettings {
         RuntimeSettings {
             deadline_ms: 250.0,
             budget_ms: StageBudgets::default(),
+            scheduling: Scheduling::Normal,
+            fifo_priority: 20,
         }
     }
+}
+
+/// `[runtime] scheduling`: the frame loop's thread under the kernel's default time sharing,
+/// or real-time.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Default)]
+#[serde(rename_all = "lowercase")]
+pub enum Scheduling {
+    /// Time shared with every other process (`SCHED_OTHER`).
+    #[default]
+    Normal,
+    /// `SCHED_FIFO` at `fifo_priority`, memory locked: other load cannot delay a frame. Needs
+    /// root, `CAP_SYS_NICE` or an RLIMIT_RTPRIO (the systemd unit sets it); without it the run goes on at
+    /// normal priority and says so.
+    Fifo,
 }
 
 /// `[runtime.budget_ms]`: each stage's budget, ms; unset ones are a share of the deadline.
@@ -450,6 +472,12 @@ impl Config {
                 b.threads
             ));
         }
+        if !(1..=99).contains(&self.runtime.fifo_priority) {
+            return Err(format!(
+                "runtime.fifo_priority = {}: must be within 1..=99",
+                self.runtime.fifo_priority
+            ));
+        }
         let d = self.runtime.deadline_ms;
         if !(d.is_finite() && d > 0.0 && d <= 10_000.0) {
             return Err(format!(
@@ -641,5 +669,12 @@ mod test {
         assert!(bad.validate().unwrap_err().contains("method_a.eps_min_m"));
         let bad: Config = toml::from_str("[runtime]\ndeadline_ms = -1.0\n").unwrap();
         assert!(bad.validate().unwrap_err().contains("runtime.deadline_ms"));
+        let bad: Config = toml::from_str("[runtime]\nfifo_priority = 0\n").unwrap();
+        assert!(bad.validate().unwrap_err().contains("runtime.fifo_priority"));
+        let e = toml::from_str::<Config>("[runtime]\nscheduling = \"rr\"\n").unwrap_err();
+        assert!(e.to_string().contains("scheduling"), "{e}");
+        let ok: Config = toml::from_str("[runtime]\nscheduling = \"fifo\"\n").unwrap();
+        assert_eq!(ok.runtime.scheduling, Scheduling::Fifo);
+        ok.validate().unwrap();
     }
 }

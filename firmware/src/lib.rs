@@ -35,6 +35,7 @@ pub mod odom;
 pub mod output;
 pub mod power;
 pub mod reader;
+pub mod realtime;
 #[cfg(feature = "viz")]
 pub mod recording;
 pub mod report;

@@ -463,6 +463,8 @@ fn run_loop(
         viz,
         snapshot: common.snapshot.clone(),
     };
+    let scheduling = firmware::realtime::apply(cfg.runtime.scheduling, cfg.runtime.fifo_priority);
+    log::info!("frame loop: {scheduling}");
     let summary = match source.model() {
         Some(model) => {
             let stream = drivers::lidar::AnyLidar::new(model, &cfg.lidar());
@@ -485,6 +487,7 @@ fn run_loop(
     }
     .map_err(|e| (EXIT_FAULT, format!("cannot write output: {e}")))?;
     print_summary(&summary);
+    eprintln!("frame loop scheduling: {scheduling}");
     Ok(())
 }
 
