@@ -670,7 +670,11 @@ mod test {
         let bad: Config = toml::from_str("[runtime]\ndeadline_ms = -1.0\n").unwrap();
         assert!(bad.validate().unwrap_err().contains("runtime.deadline_ms"));
         let bad: Config = toml::from_str("[runtime]\nfifo_priority = 0\n").unwrap();
-        assert!(bad.validate().unwrap_err().contains("runtime.fifo_priority"));
+        assert!(
+            bad.validate()
+                .unwrap_err()
+                .contains("runtime.fifo_priority")
+        );
         let e = toml::from_str::<Config>("[runtime]\nscheduling = \"rr\"\n").unwrap_err();
         assert!(e.to_string().contains("scheduling"), "{e}");
         let ok: Config = toml::from_str("[runtime]\nscheduling = \"fifo\"\n").unwrap();

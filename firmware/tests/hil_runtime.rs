@@ -377,3 +377,71 @@ fn whole_runtime_survives_garbage_a_stalled_motor_and_unplugs_and_reports_them()
     );
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+#[test]
+fn sigterm_stops_the_motor_flushes_the_lines_and_prints_the_report() {
+    let dir = std::env::temp_dir().join(format!("umbra-hil-sigterm-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let link = dir.join("ttyLDS");
+    let done = Arc::new(AtomicBool::new(false));
+    let first = plug(&link);
+    let lidar = {
+        let done = done.clone();
+        thread::spawn(move || {
+            let mut player = Lds01Player {
+                sim: Lds01Sim::new(World::random_room(3), Lds01SimConfig::default(), 3),
+                rng: 1,
+            };
+            let mut master = first;
+            let mut heard = Vec::new();
+            let mut log = LidarLog::default();
+            assert!(
+                expect_byte(&mut master, b'b', Duration::from_secs(10), &mut heard),
+                "no motor-start byte"
+            );
+            player.play(&mut master, 100, &done, &mut log);
+            saw_stop_byte(master, &heard)
+        })
+    };
+    let cfg = dir.join("cfg.toml");
+    std::fs::write(&cfg, "[method_b]\nenabled = false\n").unwrap();
+    let jsonl = dir.join("out.jsonl");
+    let err_path = dir.join("stderr.log");
+    let child = Command::new(env!("CARGO_BIN_EXE_umbra"))
+        .arg("run")
+        .arg("--lidar")
+        .arg(&link)
+        .args(["--lidar-model", "lds01", "--quiet"])
+        .arg("--config")
+        .arg(&cfg)
+        .arg("--jsonl")
+        .arg(&jsonl)
+        .env("RUST_LOG", "info")
+        .stderr(std::fs::File::create(&err_path).unwrap())
+        .spawn()
+        .expect("umbra runs");
+    // Two seconds of frames (~10 revolutions), then the service manager's stop.
+    thread::sleep(Duration::from_secs(2));
+    let killed = Command::new("kill")
+        .args(["-TERM", &child.id().to_string()])
+        .status()
+        .expect("kill");
+    assert!(killed.success());
+    let out = child.wait_with_output().expect("umbra ends");
+    done.store(true, Ordering::Relaxed);
+    let stopped = lidar.join().expect("LDS-01 emulator");
+    let stderr = std::fs::read_to_string(&err_path).unwrap_or_default();
+    println!("{stderr}");
+    assert!(out.status.success(), "a clean stop: {:?}", out.status);
+    assert!(stderr.contains("stopped by signal"), "{stderr}");
+    assert!(stderr.contains("| total |"), "the report is printed");
+    assert!(stopped, "the motor was stopped (`e`)");
+    let text = std::fs::read_to_string(&jsonl).unwrap();
+    let lines: Vec<serde_json::Value> = text
+        .lines()
+        .map(|l| serde_json::from_str(l).expect("every line whole"))
+        .collect();
+    assert!(text.ends_with('\n'));
+    assert!(lines.len() >= 5, "{} frames flushed", lines.len());
+    let _ = std::fs::remove_dir_all(&dir);
+}
