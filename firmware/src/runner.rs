@@ -280,6 +280,17 @@ impl PoseInput {
         self.queue.push_back(r);
     }
 
+    /// Lets `drain` append samples to the queue (the simulator's, a log's) and notes each for
+    /// the recording.
+    fn take_from(&mut self, drain: impl FnOnce(&mut VecDeque<OdomRecord>)) {
+        let before = self.queue.len();
+        drain(&mut self.queue);
+        for k in before..self.queue.len() {
+            let r = self.queue[k];
+            self.state.note_available(&r);
+        }
+    }
+
     /// Makes a recording's samples available at the frames they were in the recorded run.
     fn take_scheduled(&mut self, frame: u64) {
         while let Some(&(f, r)) = self.scheduled.get(self.scheduled_next) {
@@ -490,12 +501,7 @@ pub fn run<S: FrameStream>(
             }
         }
         if let Some(p) = opts.pose.as_mut() {
-            let before = p.queue.len();
-            source.drain_odometry(&mut p.queue);
-            for k in before..p.queue.len() {
-                let r = p.queue[k];
-                p.state.note_available(&r);
-            }
+            p.take_from(|q| source.drain_odometry(q));
         }
         let mut input = &buf[..n.min(READ_CHUNK)];
         let now = (!source.is_file()).then(|| link_us(state.busy));
@@ -505,12 +511,9 @@ pub fn run<S: FrameStream>(
             ingest += t_feed.elapsed();
             if let Some(p) = opts.pose.as_mut() {
                 // A log's odometry lines, up to the frame's scan.
-                let before = p.queue.len();
-                stream.drain_odometry(&mut p.queue);
-                for k in before..p.queue.len() {
-                    let r = p.queue[k];
-                    p.state.note_available(&r);
-                }
+                p.take_from(|q| {
+                    stream.drain_odometry(q);
+                });
             }
             if !done {
                 break;

@@ -13,7 +13,7 @@
 //! The runtime must keep going through all of it, end cleanly with its report, and count every
 //! fault in its output lines; its pose must follow the wheels.
 
-use std::io::{Read, Write};
+use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::sync::Arc;
@@ -21,11 +21,11 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::thread;
 use std::time::{Duration, Instant};
 
-use drivers::dynamixel::{INST_STATUS, StatusDecoder, emit};
 use drivers::lds01::PACKET_LEN;
 use drivers::lds01::packet::Packet;
-use serialport::{SerialPort, TTYPort};
+use serialport::TTYPort;
 use sim::lds01::{Lds01Sim, Lds01SimConfig};
+use sim::pty::{expect_byte, saw_stop_byte, serve_opencr};
 use sim::world::World;
 
 /// Frames the runtime is asked for: the phases before the replug give ~11, so the last ones
@@ -36,46 +36,9 @@ const FRAMES: usize = 18;
 const TICKS_PER_S: f64 = 800.0;
 const METRES_PER_TICK: f64 = 2.0 * std::f64::consts::PI * 0.033 / 4096.0;
 
-/// A new pty whose slave is reachable at `link` (calling it again is a replug). The master's
-/// descriptor is made close-on-exec: `serialport` opens it without, so the `umbra` child would
-/// inherit it and hold the pty open through an unplug.
+/// A new pty behind `link` (again: a replug), 5 ms reads.
 fn plug(link: &Path) -> TTYPort {
-    use std::os::fd::{FromRawFd, IntoRawFd, OwnedFd};
-    let (master, slave) = TTYPort::pair().expect("pty pair");
-    let name = slave.name().expect("slave name");
-    drop(slave);
-    // SAFETY: the descriptor comes from `into_raw_fd`: open, and owned by nobody else.
-    #[allow(unsafe_code)]
-    let raw = unsafe { OwnedFd::from_raw_fd(master.into_raw_fd()) };
-    // `try_clone` duplicates with F_DUPFD_CLOEXEC; dropping `raw` closes the inheritable one.
-    let cloexec = raw.try_clone().expect("dup pty master");
-    drop(raw);
-    // SAFETY: as above.
-    #[allow(unsafe_code)]
-    let mut master = unsafe { TTYPort::from_raw_fd(cloexec.into_raw_fd()) };
-    master
-        .set_timeout(Duration::from_millis(5))
-        .expect("pty timeout");
-    let tmp = link.with_extension("new");
-    let _ = std::fs::remove_file(&tmp);
-    std::os::unix::fs::symlink(&name, &tmp).expect("symlink");
-    std::fs::rename(&tmp, link).expect("rename symlink");
-    master
-}
-
-/// Waits up to `timeout` for `byte` on `master`; everything heard goes into `heard`.
-fn expect_byte(master: &mut TTYPort, byte: u8, timeout: Duration, heard: &mut Vec<u8>) -> bool {
-    let end = Instant::now() + timeout;
-    let mut buf = [0u8; 64];
-    while Instant::now() < end {
-        if let Ok(n) = master.read(&mut buf) {
-            heard.extend_from_slice(&buf[..n]);
-            if buf[..n].contains(&byte) {
-                return true;
-            }
-        }
-    }
-    false
+    sim::pty::plug(link, Duration::from_millis(5))
 }
 
 /// What the emulated LDS-01 did and heard.
@@ -159,28 +122,6 @@ impl Lds01Player {
     }
 }
 
-/// Reads `master` until end of file or 5 s and tells whether the stop byte `e` came (plain
-/// file reads: `serialport` reports a hang-up before the bytes that preceded it).
-fn saw_stop_byte(master: TTYPort, heard: &[u8]) -> bool {
-    use std::os::fd::{FromRawFd, IntoRawFd};
-    if heard.contains(&b'e') {
-        return true;
-    }
-    // SAFETY: the descriptor comes from `into_raw_fd`, so it is open and owned by nobody else.
-    #[allow(unsafe_code)]
-    let mut file = unsafe { std::fs::File::from_raw_fd(master.into_raw_fd()) };
-    let end = Instant::now() + Duration::from_secs(5);
-    let mut buf = [0u8; 64];
-    while Instant::now() < end {
-        match file.read(&mut buf) {
-            Ok(n) if buf[..n].contains(&b'e') => return true,
-            Ok(0) | Err(_) => thread::sleep(Duration::from_millis(20)),
-            Ok(_) => {}
-        }
-    }
-    false
-}
-
 fn lds01(link: PathBuf, first: TTYPort, done: Arc<AtomicBool>) -> (LidarLog, bool) {
     let mut log = LidarLog::default();
     let mut player = Lds01Player {
@@ -211,52 +152,53 @@ fn lds01(link: PathBuf, first: TTYPort, done: Arc<AtomicBool>) -> (LidarLog, boo
     (log, stopped)
 }
 
-/// Serves the OpenCR's READs (id 200, present positions at 136/140) for a robot driving
-/// straight at [`TICKS_PER_S`] since `t0`; unplugged from 3.0 s to 3.5 s.
+/// Plays the OpenCR for a robot driving straight at [`TICKS_PER_S`] since `t0`; unplugged
+/// from 3.0 s to 3.5 s. Returns the READs answered.
 fn opencr(link: PathBuf, first: TTYPort, t0: Instant, done: Arc<AtomicBool>) -> u64 {
+    let ticks = || {
+        let t = (t0.elapsed().as_secs_f64() * TICKS_PER_S) as i32;
+        (t, t)
+    };
+    let unplug = AtomicBool::new(false);
     let mut master = first;
-    let mut dec = StatusDecoder::new();
-    let mut buf = [0u8; 256];
-    let mut answered = 0;
-    let mut unplugged = false;
-    while !done.load(Ordering::Relaxed) {
-        if !unplugged && t0.elapsed() > Duration::from_millis(3000) {
-            drop(std::mem::replace(
-                &mut master,
-                plug(&link.with_extension("void")),
-            ));
-            thread::sleep(Duration::from_millis(500));
-            master = plug(&link);
-            dec = StatusDecoder::new();
-            unplugged = true;
-        }
-        let n = match master.read(&mut buf) {
-            Ok(n) => n,
-            Err(_) => {
-                thread::sleep(Duration::from_millis(2));
-                continue;
+    let before = thread::scope(|s| {
+        s.spawn(|| {
+            while t0.elapsed() < Duration::from_millis(3000) && !done.load(Ordering::Relaxed) {
+                thread::sleep(Duration::from_millis(10));
             }
-        };
-        let mut input = &buf[..n];
-        while let Some(p) = dec.next_packet(&mut input) {
-            let Some((addr, len)) = p.read_args().filter(|_| p.id == 200) else {
-                continue;
-            };
-            let ticks = (t0.elapsed().as_secs_f64() * TICKS_PER_S) as i32;
-            let mut table = [0u8; 256];
-            table[136..140].copy_from_slice(&ticks.to_le_bytes());
-            table[140..144].copy_from_slice(&ticks.to_le_bytes());
-            let (a, l) = (usize::from(addr), usize::from(len).min(64));
-            let mut params = [0u8; 65];
-            params[1..=l].copy_from_slice(&table[a..(a + l).min(256)][..l]);
-            let mut out = [0u8; 96];
-            if let Ok(n) = emit(200, INST_STATUS, &params[..=l], &mut out) {
-                let _ = master.write_all(&out[..n]);
-                answered += 1;
-            }
-        }
-    }
-    answered
+            unplug.store(true, Ordering::Relaxed);
+        });
+        serve_opencr(&mut master, &unplug, ticks)
+    });
+    drop(master); // unplug
+    thread::sleep(Duration::from_millis(500));
+    let mut master = plug(&link); // replug
+    before + serve_opencr(&mut master, &done, ticks)
+}
+
+/// `umbra run --quiet` with Method B off, its JSON lines and its log (info) in files under
+/// `dir`: the command (ports to be added), and the two paths.
+fn umbra_run(dir: &Path) -> (Command, PathBuf, PathBuf) {
+    let cfg = dir.join("cfg.toml");
+    std::fs::write(&cfg, "[method_b]\nenabled = false\n").unwrap();
+    let (jsonl, log) = (dir.join("out.jsonl"), dir.join("stderr.log"));
+    let mut c = Command::new(env!("CARGO_BIN_EXE_umbra"));
+    c.args(["run", "--quiet", "--config"])
+        .arg(&cfg)
+        .arg("--jsonl")
+        .arg(&jsonl)
+        .env("RUST_LOG", "info")
+        .stderr(std::fs::File::create(&log).unwrap());
+    (c, jsonl, log)
+}
+
+/// The JSON lines of a run (each must be whole).
+fn json_lines(path: &Path) -> Vec<serde_json::Value> {
+    std::fs::read_to_string(path)
+        .unwrap()
+        .lines()
+        .map(|l| serde_json::from_str(l).expect("every line whole"))
+        .collect()
 }
 
 #[test]
@@ -275,23 +217,13 @@ fn whole_runtime_survives_garbage_a_stalled_motor_and_unplugs_and_reports_them()
         let (first, link, done) = (plug(&opencr_link), opencr_link.clone(), done.clone());
         thread::spawn(move || opencr(link, first, t0, done))
     };
-    let cfg = dir.join("cfg.toml");
-    std::fs::write(&cfg, "[method_b]\nenabled = false\n").unwrap();
-    let jsonl = dir.join("out.jsonl");
-    let err_path = dir.join("stderr.log");
-    let out = Command::new(env!("CARGO_BIN_EXE_umbra"))
-        .arg("run")
+    let (mut umbra, jsonl, err_path) = umbra_run(&dir);
+    let out = umbra
         .arg("--lidar")
         .arg(&lidar_link)
         .arg("--opencr")
         .arg(&opencr_link)
-        .args(["--frames", &FRAMES.to_string(), "--quiet"])
-        .arg("--config")
-        .arg(&cfg)
-        .arg("--jsonl")
-        .arg(&jsonl)
-        .env("RUST_LOG", "info")
-        .stderr(std::fs::File::create(&err_path).unwrap())
+        .args(["--frames", &FRAMES.to_string()])
         .output()
         .expect("umbra runs");
     let ended = Instant::now();
@@ -322,11 +254,7 @@ fn whole_runtime_survives_garbage_a_stalled_motor_and_unplugs_and_reports_them()
     );
     assert!(answered > 20, "the OpenCR was polled");
 
-    let lines: Vec<serde_json::Value> = std::fs::read_to_string(&jsonl)
-        .unwrap()
-        .lines()
-        .map(|l| serde_json::from_str(l).unwrap())
-        .collect();
+    let lines = json_lines(&jsonl);
     assert_eq!(lines.len(), FRAMES, "every frame asked for came");
     let last = &lines[FRAMES - 1]["faults"];
     println!("last faults: {last}");
@@ -403,21 +331,11 @@ fn sigterm_stops_the_motor_flushes_the_lines_and_prints_the_report() {
             saw_stop_byte(master, &heard)
         })
     };
-    let cfg = dir.join("cfg.toml");
-    std::fs::write(&cfg, "[method_b]\nenabled = false\n").unwrap();
-    let jsonl = dir.join("out.jsonl");
-    let err_path = dir.join("stderr.log");
-    let child = Command::new(env!("CARGO_BIN_EXE_umbra"))
-        .arg("run")
+    let (mut umbra, jsonl, err_path) = umbra_run(&dir);
+    let child = umbra
         .arg("--lidar")
         .arg(&link)
-        .args(["--lidar-model", "lds01", "--quiet"])
-        .arg("--config")
-        .arg(&cfg)
-        .arg("--jsonl")
-        .arg(&jsonl)
-        .env("RUST_LOG", "info")
-        .stderr(std::fs::File::create(&err_path).unwrap())
+        .args(["--lidar-model", "lds01"])
         .spawn()
         .expect("umbra runs");
     // Two seconds of frames (~10 revolutions), then the service manager's stop.
@@ -436,12 +354,8 @@ fn sigterm_stops_the_motor_flushes_the_lines_and_prints_the_report() {
     assert!(stderr.contains("stopped by signal"), "{stderr}");
     assert!(stderr.contains("| total |"), "the report is printed");
     assert!(stopped, "the motor was stopped (`e`)");
-    let text = std::fs::read_to_string(&jsonl).unwrap();
-    let lines: Vec<serde_json::Value> = text
-        .lines()
-        .map(|l| serde_json::from_str(l).expect("every line whole"))
-        .collect();
-    assert!(text.ends_with('\n'));
+    assert!(std::fs::read_to_string(&jsonl).unwrap().ends_with('\n'));
+    let lines = json_lines(&jsonl);
     assert!(lines.len() >= 5, "{} frames flushed", lines.len());
     let _ = std::fs::remove_dir_all(&dir);
 }

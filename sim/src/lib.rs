@@ -20,6 +20,7 @@
 //! | [`pose_eval`] | drift of odometry, compass overwrite and our fusion on the simulator   |
 //! | [`scenes_a`]  | Method A run on simulated scenes, with truth labels for training and scoring |
 //! | [`corrupt`]   | a noisy serial line: bit flips, inserted and dropped bytes, with truth |
+//! | `pty`         | devices on pseudo-terminals for hardware-in-the-loop tests (feature `pty`) |
 #![deny(unsafe_code, missing_docs)]
 
 pub mod compass;
@@ -31,6 +32,8 @@ pub mod lds01;
 pub mod noise;
 pub mod picture;
 pub mod pose_eval;
+#[cfg(feature = "pty")]
+pub mod pty;
 pub mod robot;
 pub mod scenario;
 pub mod scenes_a;

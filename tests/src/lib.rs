@@ -17,16 +17,7 @@ pub fn shared_data() -> Option<PathBuf> {
 /// # Panics
 /// If the pty or the symlink cannot be made (a test fixture: failing loudly is right).
 pub fn plug_pty(link: &std::path::Path, timeout: std::time::Duration) -> serialport::TTYPort {
-    use serialport::SerialPort;
-    let (mut master, slave) = serialport::TTYPort::pair().expect("pty pair");
-    let name = slave.name().expect("slave name");
-    drop(slave);
-    master.set_timeout(timeout).expect("pty timeout");
-    let tmp = link.with_extension("new");
-    let _ = std::fs::remove_file(&tmp);
-    std::os::unix::fs::symlink(&name, &tmp).expect("symlink");
-    std::fs::rename(&tmp, link).expect("rename symlink");
-    master
+    sim::pty::plug(link, timeout)
 }
 
 /// A global allocator that counts the allocations (and reallocations) made on the current

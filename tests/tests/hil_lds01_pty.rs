@@ -9,7 +9,7 @@
 //! (an unplug), waits, opens a new pty and points the symlink at it (a replug). The reader must
 //! report the loss, reopen with back-off, resend `b`, and carry on; on drop it must send `e`.
 
-use std::io::{Read, Write};
+use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::sync::mpsc;
 use std::thread;
@@ -20,6 +20,7 @@ use drivers::lidar::LidarStream as _;
 use drivers::serial::{LinkRead, SerialConfig, SerialLink};
 use serialport::TTYPort;
 use sim::lds01::{Lds01Sim, Lds01SimConfig};
+use sim::pty::{expect_byte, saw_stop_byte};
 use sim::world::World;
 
 const PHASE_REVOLUTIONS: usize = 10;
@@ -34,40 +35,6 @@ fn plug(link: &Path) -> Link {
     Link {
         master: umbra_tests::plug_pty(link, Duration::from_millis(100)),
     }
-}
-
-/// Waits up to `timeout` for `byte` to arrive on the master side.
-fn expect_byte(master: &mut TTYPort, byte: u8, timeout: Duration) -> bool {
-    let end = Instant::now() + timeout;
-    let mut buf = [0u8; 64];
-    while Instant::now() < end {
-        if let Ok(n) = master.read(&mut buf)
-            && buf[..n].contains(&byte)
-        {
-            return true;
-        }
-    }
-    false
-}
-
-/// Reads the master side until end of file and tells whether the stop byte `e` came. Plain
-/// file reads are used because `serialport` reports a hang-up before the bytes that preceded it,
-/// and the reader closes its side right after writing `e`.
-fn saw_stop_byte(master: TTYPort) -> bool {
-    use std::os::fd::{FromRawFd, IntoRawFd};
-    // SAFETY: the descriptor comes from `into_raw_fd`, so it is open and owned by nobody else.
-    #[allow(unsafe_code)]
-    let mut file = unsafe { std::fs::File::from_raw_fd(master.into_raw_fd()) };
-    let end = Instant::now() + Duration::from_secs(5);
-    let mut buf = [0u8; 64];
-    while Instant::now() < end {
-        match file.read(&mut buf) {
-            Ok(n) if buf[..n].contains(&b'e') => return true,
-            Ok(0) | Err(_) => thread::sleep(Duration::from_millis(20)),
-            Ok(_) => {}
-        }
-    }
-    false
 }
 
 /// Writes `revolutions` of packets paced at the link rate, garbage every few packets.
@@ -114,7 +81,12 @@ fn pty_link_paced_with_garbage_and_replug() {
         let mut sim = Lds01Sim::new(World::random_room(9), Lds01SimConfig::default(), 9);
         let mut link = first;
         assert!(
-            expect_byte(&mut link.master, b'b', Duration::from_secs(5)),
+            expect_byte(
+                &mut link.master,
+                b'b',
+                Duration::from_secs(5),
+                &mut Vec::new()
+            ),
             "no motor-start byte"
         );
         let g1 = play(&mut link.master, &mut sim, PHASE_REVOLUTIONS);
@@ -123,12 +95,17 @@ fn pty_link_paced_with_garbage_and_replug() {
         thread::sleep(Duration::from_millis(400));
         let mut link = plug(&writer_path); // replug
         assert!(
-            expect_byte(&mut link.master, b'b', Duration::from_secs(10)),
+            expect_byte(
+                &mut link.master,
+                b'b',
+                Duration::from_secs(10),
+                &mut Vec::new()
+            ),
             "no motor-start byte after reopen"
         );
         let g2 = play(&mut link.master, &mut sim, PHASE_REVOLUTIONS);
         tx.send("done").unwrap();
-        (g1 + g2, saw_stop_byte(link.master))
+        (g1 + g2, saw_stop_byte(link.master, &[]))
     });
 
     let mut serial = SerialLink::open(link_path.to_str().unwrap(), SerialConfig::lds01())

@@ -5,14 +5,12 @@
 //! must follow the simulator's true pose; an unplug/replug (new pty behind the same symlink)
 //! must be reported and survived.
 
-use std::io::{Read, Write};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex};
 use std::thread;
 use std::time::{Duration, Instant};
 
-use drivers::dynamixel::{INST_STATUS, StatusDecoder, emit};
 use drivers::opencr::{OpencrConfig, OpencrReader};
 use perception::geometry::{Pose2, wrap_angle};
 use perception::pose::{HeadingConfig, OdometryConfig, PoseFilter};
@@ -24,52 +22,22 @@ fn plug(link: &Path) -> TTYPort {
     umbra_tests::plug_pty(link, Duration::from_millis(5))
 }
 
-/// Serves READs on `master` until `stop`, stepping `robot` in real time.
+/// Serves READs on `master` until `stop`, stepping `robot` in real time: the present
+/// positions are the robot's encoder ticks at the moment of each request.
 fn serve(master: &mut TTYPort, robot: &Mutex<(Robot, Instant)>, stop: &AtomicBool) -> u64 {
-    let mut dec = StatusDecoder::new();
-    let mut buf = [0u8; 256];
-    let mut answered = 0;
-    while !stop.load(Ordering::Relaxed) {
-        let n = match master.read(&mut buf) {
-            Ok(n) => n,
-            // No slave side open yet (EIO / hang-up on a pty master) or nothing to read.
-            Err(_) => {
-                thread::sleep(Duration::from_millis(2));
-                continue;
-            }
-        };
-        let mut input = &buf[..n];
-        while let Some(p) = dec.next_packet(&mut input) {
-            let Some((addr, len)) = p.read_args().filter(|_| p.id == 200) else {
-                continue;
-            };
-            let mut table = [0u8; 256];
-            {
-                let mut g = robot.lock().unwrap();
-                let (r, last) = &mut *g;
-                let now = Instant::now();
-                let mut dt = (now - *last).as_secs_f32();
-                while dt > 0.0 {
-                    let s = dt.min(0.002);
-                    r.step(s);
-                    dt -= s;
-                }
-                *last = now;
-                let (l, rt) = r.ticks();
-                table[136..140].copy_from_slice(&l.to_le_bytes());
-                table[140..144].copy_from_slice(&rt.to_le_bytes());
-            }
-            let (a, l) = (usize::from(addr), usize::from(len));
-            let mut params = [0u8; 65];
-            params[1..=l.min(64)].copy_from_slice(&table[a..(a + l).min(256)][..l.min(64)]);
-            let mut out = [0u8; 64];
-            if let Ok(n) = emit(200, INST_STATUS, &params[..=l.min(64)], &mut out) {
-                let _ = master.write_all(&out[..n]);
-                answered += 1;
-            }
+    sim::pty::serve_opencr(master, stop, || {
+        let mut g = robot.lock().unwrap();
+        let (r, last) = &mut *g;
+        let now = Instant::now();
+        let mut dt = (now - *last).as_secs_f32();
+        while dt > 0.0 {
+            let s = dt.min(0.002);
+            r.step(s);
+            dt -= s;
         }
-    }
-    answered
+        *last = now;
+        r.ticks()
+    })
 }
 
 #[test]
