@@ -96,6 +96,35 @@ pub const PROBE_LISTEN_MS: u64 = 1500;
 /// Bytes of a capture read to recognise its model (several revolutions of any model).
 pub const DETECT_BYTES: usize = 64 * 1024;
 
+/// Recognises the model whose bytes `head` holds (a capture's or a recording's first
+/// [`DETECT_BYTES`]); `what` names the file in messages. Frames with a high error rate are
+/// used, with a warning; an RPLIDAR is taken for an A1 (an A2 sends the same bytes), with a
+/// warning; no frames at all is an error.
+fn recognise(head: &[u8], what: &str) -> Result<(LidarModel, String), String> {
+    let mut det = Detector::new();
+    det.feed(head);
+    let verdict = det.verdict();
+    let words = drivers::probe::describe(&verdict);
+    if let Verdict::Found { model, .. } | Verdict::HighErrorRate { model, .. } = verdict
+        && model.family() == drivers::lidar::Family::Rplidar
+    {
+        log::warn!(
+            "{what}: an RPLIDAR A1 and A2 send the same bytes and nodes carry no time; the clock assumes the A1's 2 kHz (name --lidar-model rplidar-a2 for an A2)"
+        );
+    }
+    match verdict {
+        Verdict::Found { model, .. } => Ok((model, format!("recognised: {words}"))),
+        Verdict::HighErrorRate { model, .. } => {
+            log::warn!("{what}: {words}");
+            Ok((model, format!("{model} recognised despite errors")))
+        }
+        _ => Err(format!(
+            "{what}: no LiDAR recognised in its first {} bytes: {words}",
+            head.len()
+        )),
+    }
+}
+
 /// How long a read of a serial source waits for the reader thread.
 pub const SERIAL_WAIT: Duration = Duration::from_millis(20);
 
@@ -163,22 +192,10 @@ impl LidarSource {
         let (model, how) = match (model, rec.model) {
             (Some(m), _) => (m, format!("{m} named")),
             (None, Some(m)) => (m, format!("{m}, as the recording says")),
-            (None, None) => {
-                let mut det = Detector::new();
-                det.feed(&rec.bytes[..rec.bytes.len().min(DETECT_BYTES)]);
-                let verdict = det.verdict();
-                let words = drivers::probe::describe(&verdict);
-                match verdict {
-                    Verdict::Found { model, .. } | Verdict::HighErrorRate { model, .. } => {
-                        (model, format!("recognised: {words}"))
-                    }
-                    _ => {
-                        return Err(format!(
-                            "recording {shown}: no LiDAR recognised in its bytes: {words}"
-                        ));
-                    }
-                }
-            }
+            (None, None) => recognise(
+                &rec.bytes[..rec.bytes.len().min(DETECT_BYTES)],
+                &format!("recording {shown}"),
+            )?,
         };
         Ok((
             LidarSource::Recorded {
@@ -206,32 +223,7 @@ impl LidarSource {
                     .read_to_end(&mut head)
                     .and_then(|_| file.rewind())
                     .map_err(|e| format!("cannot read capture {}: {e}", path.display()))?;
-                let mut det = Detector::new();
-                det.feed(&head);
-                let verdict = det.verdict();
-                let words = drivers::probe::describe(&verdict);
-                if let Verdict::Found { model, .. } | Verdict::HighErrorRate { model, .. } = verdict
-                    && model.family() == drivers::lidar::Family::Rplidar
-                {
-                    log::warn!(
-                        "capture {}: an RPLIDAR A1 and A2 send the same bytes and nodes carry no time; the clock assumes the A1's 2 kHz (name --lidar-model rplidar-a2 for an A2)",
-                        path.display()
-                    );
-                }
-                match verdict {
-                    Verdict::Found { model, .. } => (model, format!("recognised: {words}")),
-                    Verdict::HighErrorRate { model, .. } => {
-                        log::warn!("capture {}: {words}", path.display());
-                        (model, format!("{model} recognised despite errors"))
-                    }
-                    _ => {
-                        return Err(format!(
-                            "capture {}: no LiDAR recognised in its first {} bytes: {words}",
-                            path.display(),
-                            head.len()
-                        ));
-                    }
-                }
+                recognise(&head, &format!("capture {}", path.display()))?
             }
         };
         Ok((
