@@ -28,10 +28,26 @@ OFF = dict(
 )
 
 
+# The optimiser, pinned: with `optimizer="auto"` Ultralytics picks AdamW (lr 0.00125 for 4
+# classes) below 10k iterations and switches to SGD (lr 0.01) above, so a longer run would
+# silently change optimiser. A continuation (`--init`) warms up briefly and decays on a cosine.
+SCHEDULE = dict(optimizer="AdamW", lr0=0.00125, lrf=0.01, momentum=0.937, weight_decay=0.0005)
+
+
 def train(data: Path, epochs: int, batch: int = 32, seed: int = 0, device: str = "cpu",
           workers: int = 2, name: str = "small", resume: bool = False, mirror: float = 0.5,
-          init: Path | None = None) -> Path:
-    """Train (or resume) one run; returns its weights folder."""
+          init: Path | None = None, lr0: float | None = None, cache: str | bool = "ram") -> Path:
+    """Train (or resume) one run; returns its weights folder.
+
+    Every image is 64 x 384, so the `rect` batch shapes are all equal and Ultralytics keeps the
+    DataLoader's shuffling on (it turns it off only for unequal shapes);
+    `training/test_training.py` checks that two epochs see different orders.
+    """
+    sched = dict(SCHEDULE)
+    if init:
+        sched.update(warmup_epochs=0.2, cos_lr=True)
+    if lr0 is not None:
+        sched["lr0"] = lr0
     ExactTrainer.mirror_p = mirror
     weights = HERE / "runs" / name / "weights"
     if resume:
@@ -42,7 +58,7 @@ def train(data: Path, epochs: int, batch: int = 32, seed: int = 0, device: str =
             workers=workers, device=device, seed=seed, deterministic=True,
             pretrained=str(init) if init else False, amp=device != "cpu", plots=False,
             project=str(HERE / "runs"), name=name, exist_ok=True, val=True,
-            trainer=ExactTrainer, **OFF,
+            trainer=ExactTrainer, cache=cache, **sched, **OFF,
         )
     return weights
 
@@ -60,11 +76,13 @@ def main() -> None:
                     help="probability of a mirrored room (training/mirror.py); 0 = off")
     ap.add_argument("--init", type=Path, help="start from these weights (e.g. the committed .pt)")
     ap.add_argument("--resume", action="store_true", help="continue runs/NAME/weights/last.pt")
+    ap.add_argument("--lr0", type=float, help=f"initial learning rate (default {SCHEDULE['lr0']})")
+    ap.add_argument("--no-cache", action="store_true", help="read images from disk each epoch")
     a = ap.parse_args()
 
     t0 = time.time()
     w = train(Path(a.data), a.epochs, a.batch, a.seed, a.device, a.workers, a.name, a.resume,
-              a.mirror, a.init)
+              a.mirror, a.init, a.lr0, False if a.no_cache else "ram")
     print(f"trained in {time.time() - t0:.0f} s: {w}")
 
 
