@@ -51,7 +51,7 @@ def sha256(p: Path) -> str:
 
 def bins() -> tuple[Path, Path]:
     sh(["cargo", "build", "--release", "-p", "umbra-sim", "--bin", "umbra-sim", "-p",
-        "umbra-firmware", "--bin", "umbra-lab"], cwd=ROOT)
+        "umbra-lab", "--bin", "umbra-lab"], cwd=ROOT)
     target = Path(os.environ.get("CARGO_TARGET_DIR", ROOT / "target")) / "release"
     return target / "umbra-sim", target / "umbra-lab"
 

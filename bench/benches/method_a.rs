@@ -8,9 +8,9 @@
 use std::hint::black_box;
 
 use criterion::{Criterion, criterion_group, criterion_main};
+use lab::scenes_a::{PoseSource, SceneConfig, run_scene};
 use perception::geometry::Point2;
 use perception::method_a::{MethodA, MethodAConfig};
-use sim::scenes_a::{PoseSource, SceneConfig, run_scene};
 
 /// The oscillating scene of seed 2 (held-out rooms) whose cloud is largest after 80
 /// revolutions (stopping at the first to reach 7,000 points). The simulated rooms with the

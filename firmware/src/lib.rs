@@ -11,9 +11,6 @@
 //! | [`runner`]   | the frame loop: ingest → output, limits, pacing             |
 //! | [`odom`]     | odometry/compass input (`--odom` JSON Lines, the simulated robot) → pose |
 //! | [`output`]   | the JSON output line (§3) and per-revolution statistics     |
-//! | [`eval_a`]   | Method A scored against the simulator's truth; forest training rows |
-//! | [`eval_b`]     | Method B scored on a dataset split: P, R, mAP50, mAP50-95 as Ultralytics does |
-//! | [`confusion_png`] | the evaluation's confusion matrix as a PNG              |
 //! | [`deadline`] | stage histograms, budgets, the overrun policy, the deadline table |
 //! | [`power`]    | watts from an INA219, the Pi 5 PMIC or a CPU-time model; the budget |
 //! | [`snapshot`] | `--snapshot PATH.svg`: the map, robot, walls, doors and objects as a picture |
@@ -25,11 +22,7 @@ pub mod calibrate;
 pub mod carmen;
 pub mod cli;
 pub mod config;
-pub mod confusion_png;
 pub mod deadline;
-pub mod eval_a;
-#[cfg(feature = "method-b")]
-pub mod eval_b;
 pub mod frames;
 pub mod odom;
 pub mod output;

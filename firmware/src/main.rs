@@ -52,15 +52,7 @@ fn dispatch(cli: Cli) -> Result<(), Failure> {
                     log::info!("LiDAR: {how}");
                     source
                 }
-                None => {
-                    if named.is_some_and(|m| m != drivers::lidar::LidarModel::Lds01) {
-                        return Err((
-                            EXIT_USAGE,
-                            "--lidar-model: the built-in simulated robot carries an LDS-01 (emit other models with `umbra-sim capture --model`)".into(),
-                        ));
-                    }
-                    LidarSource::sim(args.seed, args.seed)
-                }
+                None => simulated_robot(named, args.seed)?,
             };
             println!("umbra: {}", source.describe());
             let opencr = match &args.opencr {
@@ -168,21 +160,7 @@ fn dispatch(cli: Cli) -> Result<(), Failure> {
                         calibrate::readings_from_file(path).map_err(|m| (EXIT_USAGE, m))?;
                     (xy, bad, path.display().to_string())
                 }
-                (None, None) => {
-                    let xy = sim::scenario::Scenario::new(
-                        args.seed,
-                        &sim::scenario::ScenarioConfig::standard(),
-                    )
-                    .compass_spin_readings();
-                    (
-                        xy,
-                        0,
-                        format!(
-                            "the simulated robot (seed {}), two turns in place",
-                            args.seed
-                        ),
-                    )
-                }
+                (None, None) => simulated_spin(args.seed)?,
             };
             let c =
                 calibrate::fit(&xy).map_err(|m| (EXIT_FAULT, format!("calibrate-compass: {m}")))?;
@@ -277,6 +255,56 @@ fn dispatch(cli: Cli) -> Result<(), Failure> {
             )
         }
     }
+}
+
+/// The built-in simulated robot (no `--lidar` named).
+#[cfg(feature = "sim")]
+fn simulated_robot(
+    named: Option<drivers::lidar::LidarModel>,
+    seed: u64,
+) -> Result<LidarSource, Failure> {
+    if named.is_some_and(|m| m != drivers::lidar::LidarModel::Lds01) {
+        return Err((
+            EXIT_USAGE,
+            "--lidar-model: the built-in simulated robot carries an LDS-01 (emit other models with `umbra-sim capture --model`)".into(),
+        ));
+    }
+    Ok(LidarSource::sim(seed, seed))
+}
+
+/// Built without the simulated robot: a LiDAR must be named.
+#[cfg(not(feature = "sim"))]
+fn simulated_robot(
+    _named: Option<drivers::lidar::LidarModel>,
+    _seed: u64,
+) -> Result<LidarSource, Failure> {
+    Err((
+        EXIT_USAGE,
+        "no --lidar named, and this umbra was built without the simulated robot (feature sim)"
+            .into(),
+    ))
+}
+
+/// Compass readings of the simulated robot's two-turn spin, for `calibrate-compass` without a
+/// source.
+#[cfg(feature = "sim")]
+fn simulated_spin(seed: u64) -> Result<(Vec<[f32; 3]>, usize, String), Failure> {
+    let xy = sim::scenario::Scenario::new(seed, &sim::scenario::ScenarioConfig::standard())
+        .compass_spin_readings();
+    Ok((
+        xy,
+        0,
+        format!("the simulated robot (seed {seed}), two turns in place"),
+    ))
+}
+
+/// Built without the simulated robot: a source must be named.
+#[cfg(not(feature = "sim"))]
+fn simulated_spin(_seed: u64) -> Result<(Vec<[f32; 3]>, usize, String), Failure> {
+    Err((
+        EXIT_USAGE,
+        "calibrate-compass: name --odom or --compass (this umbra was built without the simulated robot, feature sim)".into(),
+    ))
 }
 
 /// Odometry lines and compass calibration a recording carried.

@@ -5,13 +5,16 @@ use std::fs::File;
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
+#[cfg(feature = "sim")]
 use drivers::lds01::PACKET_LEN;
 use drivers::lidar::LidarModel;
 use drivers::lidar::detect::{Detector, Verdict};
 use drivers::serial::{SerialConfig, SerialLink};
 use embedded_io::Read as _;
 use embedded_io_adapters::std::FromStd;
+#[cfg(feature = "sim")]
 use sim::lds01::Lds01Sim;
+#[cfg(feature = "sim")]
 use sim::scenario::{Scenario, ScenarioConfig};
 
 use crate::odom::OdomRecord;
@@ -80,7 +83,8 @@ pub enum LidarSource {
         /// The laser's offset forward of the robot's centre (`robot_frontlaser_offset`), m.
         laser_offset_m: Option<f32>,
     },
-    /// The built-in simulated robot.
+    /// The built-in simulated robot (feature `sim`).
+    #[cfg(feature = "sim")]
     Sim {
         /// The simulator.
         sim: Box<Lds01Sim>,
@@ -244,6 +248,7 @@ impl LidarSource {
                 Some(*model)
             }
             LidarSource::Log { .. } => None,
+            #[cfg(feature = "sim")]
             LidarSource::Sim { .. } => Some(LidarModel::Lds01),
         }
     }
@@ -272,6 +277,7 @@ impl LidarSource {
     /// The simulated robot in a seeded random room (the study's oscillation in place), with
     /// encoders and a compass at 20 Hz; the compass is calibrated by a simulated two-turn spin,
     /// as `umbra calibrate-compass` would on a robot.
+    #[cfg(feature = "sim")]
     pub fn sim(room_seed: u64, _noise_seed: u64) -> Self {
         let scenario = Scenario::new(room_seed, &ScenarioConfig::standard());
         let readings = scenario.compass_spin_readings();
@@ -311,13 +317,16 @@ impl LidarSource {
     /// simulator.
     pub fn sim_calibration(&self) -> Option<([f32; 2], [f32; 2])> {
         match self {
+            #[cfg(feature = "sim")]
             LidarSource::Sim { calibration, .. } => *calibration,
             _ => None,
         }
     }
 
     /// Moves encoder/compass samples the source produced into `out` (the simulator only).
+    #[cfg_attr(not(feature = "sim"), allow(unused_variables))]
     pub fn drain_odometry(&mut self, out: &mut std::collections::VecDeque<OdomRecord>) {
+        #[cfg(feature = "sim")]
         if let LidarSource::Sim { sim, .. } = self {
             for o in sim.drain_odometry() {
                 out.push_back(OdomRecord {
@@ -343,6 +352,7 @@ impl LidarSource {
                 format!("{model} bytes recorded in {}", path.display())
             }
             LidarSource::Log { path, .. } => format!("CARMEN log {}", path.display()),
+            #[cfg(feature = "sim")]
             LidarSource::Sim { sim, room_seed, .. } => format!(
                 "no hardware named: running on the built-in simulated robot (LDS-01; seed {room_seed}: {})",
                 sim.world().describe()
@@ -353,7 +363,10 @@ impl LidarSource {
     /// Default pacing: live sources are paced by the device itself (serial) or by the sensor
     /// clock (the simulator, so it behaves like the robot); files run as fast as possible.
     pub fn is_simulated(&self) -> bool {
-        matches!(self, LidarSource::Sim { .. })
+        #[cfg(feature = "sim")]
+        return matches!(self, LidarSource::Sim { .. });
+        #[cfg(not(feature = "sim"))]
+        false
     }
 
     /// A capture file: bytes with no timing of their own (no silence, so no staleness).
@@ -422,6 +435,7 @@ impl LidarSource {
                     Ok(n) => SourceRead::Data(n),
                 }
             }
+            #[cfg(feature = "sim")]
             LidarSource::Sim { sim, .. } => {
                 let mut n = 0;
                 for chunk in buf.chunks_exact_mut(PACKET_LEN).take(SIM_PACKETS_PER_READ) {

@@ -1,6 +1,6 @@
 //! The Method A forest as constant tables. Generated; do not edit.
 //!
-//! Regenerate with `cargo run --release -p umbra-firmware --bin umbra-lab -- forest-data && cargo run --release -p umbra-firmware --bin umbra-lab -- forest-train`.
+//! Regenerate with `cargo run --release -p umbra-lab -- forest-data && cargo run --release -p umbra-lab -- forest-train`.
 //! 50 trees, 4964 nodes, 2507 leaves; features in the object's own frame. A test retrains from the
 //! committed data and compares this file byte for byte.
 

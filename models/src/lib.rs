@@ -6,7 +6,7 @@
 //! |-------------------|----------------------------------------------------------------|
 //! | [`forest`]        | the Method A classifier at run time over `const` tables (`no_std`) |
 //! | [`forest_tables`] | the trained forest, generated from `models/data/forest-train.csv` |
-//! | `train`           | the forest trainer and table emitter (`std` feature, host only) |
+//! | `train`           | the forest trainer and table emitter (`train` feature: the lab's, host only) |
 //! | `yolo`            | the Method B YOLOv8n runner over tract (`yolo` feature, host and Pi) |
 #![cfg_attr(not(any(test, feature = "std")), no_std)]
 #![deny(unsafe_code, missing_docs)]
@@ -16,7 +16,7 @@ pub use perception::class::ObjectClass;
 pub mod forest;
 #[rustfmt::skip]
 pub mod forest_tables;
-#[cfg(feature = "std")]
+#[cfg(feature = "train")]
 pub mod train;
 #[cfg(feature = "yolo")]
 pub mod yolo;

@@ -24,7 +24,7 @@
 //!
 //! The study overwrote odometry's heading with the raw compass (`CompassOverwrite` in the
 //! evaluation); odometry alone drifts without bound; the filter is measured against both in
-//! `sim::pose_eval`.
+//! `lab::pose_eval` (the `umbra-lab` crate).
 
 use crate::geometry::{Pose2, wrap_angle};
 

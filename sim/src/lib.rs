@@ -14,28 +14,27 @@
 //! | [`lds01`]     | LDS-01 reading model and the packet byte source                       |
 //! | [`scenario`]  | world + robot + sensors stepped one revolution (frame) at a time      |
 //! | [`labels`]    | Method B boxes from footprints, per-reading labels                    |
-//! | [`dataset`]   | dataset writers: YOLO layout, Method A labels, replay recordings      |
+//! | `dataset`     | dataset writers: YOLO layout, Method A labels, replay recordings (feature `tools`) |
 //! | [`noise`]     | the bounded, unit-σ noise every sensor model draws from               |
-//! | [`picture`]   | a PNG of a scene for people to look at                                |
-//! | [`pose_eval`] | drift of odometry, compass overwrite and our fusion on the simulator   |
-//! | [`scenes_a`]  | Method A run on simulated scenes, with truth labels for training and scoring |
+//! | `picture`     | a PNG of a scene for people to look at (feature `tools`)              |
+//! | [`wire`]      | every LiDAR model's bytes from the same simulated revolutions          |
 //! | [`corrupt`]   | a noisy serial line: bit flips, inserted and dropped bytes, with truth |
 //! | `pty`         | devices on pseudo-terminals for hardware-in-the-loop tests (feature `pty`) |
 #![deny(unsafe_code, missing_docs)]
 
 pub mod compass;
 pub mod corrupt;
+#[cfg(feature = "tools")]
 pub mod dataset;
 pub mod grid;
 pub mod labels;
 pub mod lds01;
 pub mod noise;
+#[cfg(feature = "tools")]
 pub mod picture;
-pub mod pose_eval;
 #[cfg(feature = "pty")]
 pub mod pty;
 pub mod robot;
 pub mod scenario;
-pub mod scenes_a;
 pub mod wire;
 pub mod world;

@@ -109,18 +109,6 @@ enum Command {
         #[arg(long, default_value = "lds01")]
         model: String,
     },
-    /// Heading/position drift of odometry, compass overwrite and fusion (Markdown table).
-    PoseEval {
-        /// Scenarios (each run with oscillation and with a tour).
-        #[arg(long, default_value_t = 3)]
-        scenarios: usize,
-        /// Minutes per run.
-        #[arg(long, default_value_t = 10.0)]
-        minutes: f32,
-        /// Master seed.
-        #[arg(long, default_value_t = 1)]
-        seed: u64,
-    },
     /// Draw one scenario of a dataset seed as a PNG.
     Picture {
         /// Output PNG.
@@ -267,15 +255,6 @@ fn run(command: Command) -> Result<(), String> {
                 bytes.len(),
                 out.display()
             );
-            Ok(())
-        }
-        Command::PoseEval {
-            scenarios,
-            minutes,
-            seed,
-        } => {
-            let rows = sim::pose_eval::table(seed, scenarios, minutes * 60.0);
-            print!("{}", sim::pose_eval::markdown(&rows));
             Ok(())
         }
         Command::Picture {

@@ -14,11 +14,11 @@
 
 use std::fmt::Write as _;
 
+use crate::scenes_a::{SceneConfig, SceneView, TruthLabel, label_points, points_on, run_scene};
 use perception::class::ObjectClass;
 use perception::features::{self, N_FEATURES};
 use perception::geometry::Point2;
 use perception::method_a::{Classifier, MethodA, MethodAConfig};
-use sim::scenes_a::{SceneConfig, SceneView, TruthLabel, label_points, points_on, run_scene};
 
 /// Matching radius, metres.
 pub const MATCH_M: f32 = 0.3;

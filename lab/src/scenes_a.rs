@@ -13,10 +13,10 @@ use perception::geometry::{Point2, Pose2};
 use perception::method_a::{Classifier, MethodA, MethodAConfig};
 use perception::pose::{OdometryConfig, TickCounter, integrate};
 
-use crate::dataset::{scenario_config, scenario_seed};
-use crate::lds01::LIDAR_MOUNT;
-use crate::scenario::{Frame, OdomSample, Scenario};
-use crate::world::{Surface, World, WorldConfig};
+use sim::dataset::{scenario_config, scenario_seed};
+use sim::lds01::LIDAR_MOUNT;
+use sim::scenario::{Frame, OdomSample, Scenario};
+use sim::world::{Surface, World, WorldConfig};
 
 /// Where the pipeline's pose comes from.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

@@ -1,8 +1,8 @@
 //! The fused heading against odometry alone and the study's compass overwrite, on the simulator
-//! with wheel slip and compass disturbances (shortened runs; `umbra-sim pose-eval` runs the
+//! with wheel slip and compass disturbances (shortened runs; `umbra-lab pose-eval` runs the
 //! 10-minute table).
 
-use sim::pose_eval::{markdown, table};
+use lab::pose_eval::{markdown, table};
 
 #[test]
 fn fusion_beats_odometry_and_compass_overwrite_in_every_scenario() {

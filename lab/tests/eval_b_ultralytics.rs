@@ -3,7 +3,7 @@
 //! checkpoint the compiled-in ONNX was exported from, on the test split of
 //! `umbra-sim dataset --scenarios 40 --frames 50 --seed 11`. This test regenerates that split
 //! (the simulator is deterministic), runs the compiled-in model through tract and
-//! `firmware::eval_b`, and requires every figure within 0.01 of Ultralytics'.
+//! `lab::eval_b`, and requires every figure within 0.01 of Ultralytics'.
 
 use std::path::Path;
 
@@ -35,11 +35,11 @@ fn evaluator_agrees_with_ultralytics() {
     };
     generate(&cfg, &dir, |_| {}).expect("dataset");
     let mut model = models::yolo::YoloModel::builtin(Default::default()).expect("model");
-    let stats = firmware::eval_b::evaluate(&mut model, Path::new(&dir), "test", |_, _| {})
-        .expect("evaluation");
+    let stats =
+        lab::eval_b::evaluate(&mut model, Path::new(&dir), "test", |_, _| {}).expect("evaluation");
     std::fs::remove_dir_all(&dir).ok();
     let m = stats.metrics();
-    println!("{}", firmware::eval_b::table(&m));
+    println!("{}", lab::eval_b::table(&m));
     assert_eq!(m.images, refs["images"].as_u64().unwrap_or(100) as usize);
     let close = |what: &str, ours: f64, theirs: &serde_json::Value| {
         let theirs = theirs.as_f64().expect("number");

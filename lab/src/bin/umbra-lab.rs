@@ -1,4 +1,4 @@
-//! `umbra-lab`: the Method A model's workbench (host only; not flashed to a robot).
+//! `umbra-lab`: umbra's workbench (host only; never flashed to a robot).
 //!
 //! * `umbra-lab forest-data --out models/data/forest-train.csv [--seed 1] [--scenes 300]`
 //!   runs Method A on training scenes of the simulator and writes one labelled row per
@@ -14,6 +14,9 @@
 //!   YOLO model (default: the compiled-in one) on a simulator dataset split with the Rust
 //!   evaluator (P, R, mAP50, mAP50-95 as Ultralytics computes them).
 //!
+//! * `umbra-lab pose-eval [--scenarios 3] [--minutes 10] [--seed 1]` prints the heading and
+//!   position drift of odometry, the compass overwrite and our fusion (`docs/pose.md`).
+//!
 //! Regenerating the committed forest is the two commands `forest-data` and `forest-train` with
 //! their defaults; both are deterministic.
 
@@ -21,15 +24,19 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 use clap::{Parser, Subcommand, ValueEnum};
-use firmware::eval_a::{self, Score, csv_header, rows_of};
 use indicatif::{ProgressBar, ProgressStyle};
+use lab::eval_a::{self, Score, csv_header, rows_of};
+use lab::scenes_a::{PoseSource, SceneConfig, run_scene};
 use models::train::{TrainConfig, emit_rust, read_csv, train};
 use perception::features::FeatureFrame;
 use perception::method_a::{MethodA, MethodAConfig, Unclassified};
-use sim::scenes_a::{PoseSource, SceneConfig, run_scene};
 
 #[derive(Parser)]
-#[command(name = "umbra-lab", version, about = "umbra's Method A workbench")]
+#[command(
+    name = "umbra-lab",
+    version,
+    about = "umbra's workbench: forest data and training, evaluators, pose drift"
+)]
 struct Cli {
     #[command(subcommand)]
     command: Command,
@@ -48,7 +55,7 @@ enum Pose {
 }
 
 /// The regeneration command written into the tables' header.
-const TRAIN_CMD: &str = "cargo run --release -p umbra-firmware --bin umbra-lab -- forest-data && cargo run --release -p umbra-firmware --bin umbra-lab -- forest-train";
+const TRAIN_CMD: &str = "cargo run --release -p umbra-lab -- forest-data && cargo run --release -p umbra-lab -- forest-train";
 
 #[derive(Subcommand)]
 enum Command {
@@ -116,6 +123,18 @@ enum Command {
         /// Write the metrics here as JSON.
         #[arg(long)]
         json: Option<PathBuf>,
+    },
+    /// Heading/position drift of odometry, compass overwrite and fusion (Markdown table).
+    PoseEval {
+        /// Scenarios (each run with oscillation and with a tour).
+        #[arg(long, default_value_t = 3)]
+        scenarios: usize,
+        /// Minutes per run.
+        #[arg(long, default_value_t = 10.0)]
+        minutes: f32,
+        /// Master seed.
+        #[arg(long, default_value_t = 1)]
+        seed: u64,
     },
 }
 
@@ -228,9 +247,9 @@ fn run(cli: Cli) -> Result<(), String> {
             let opts = models::yolo::YoloOptions { threads };
             let mut m = models::yolo::YoloModel::load_or_builtin(model.as_deref(), opts)
                 .map_err(|e| e.to_string())?;
-            let n = firmware::eval_b::split_images(&data, &split)?.len();
+            let n = lab::eval_b::split_images(&data, &split)?.len();
             let b = bar(n, "images");
-            let stats = firmware::eval_b::evaluate(&mut m, &data, &split, |_, _| b.inc(1))?;
+            let stats = lab::eval_b::evaluate(&mut m, &data, &split, |_, _| b.inc(1))?;
             b.finish_and_clear();
             let metrics = stats.metrics();
             println!(
@@ -238,7 +257,7 @@ fn run(cli: Cli) -> Result<(), String> {
                 m.name(),
                 data.display()
             );
-            print!("{}", firmware::eval_b::table(&metrics));
+            print!("{}", lab::eval_b::table(&metrics));
             if let Some(p) = json {
                 let text = serde_json::to_string_pretty(&metrics).map_err(|e| e.to_string())?;
                 std::fs::write(&p, text).map_err(|e| format!("{}: {e}", p.display()))?;
@@ -277,7 +296,7 @@ fn run(cli: Cli) -> Result<(), String> {
             );
             println!("{}", score.markdown());
             if let Some(p) = confusion {
-                firmware::confusion_png::write(&p, &score)
+                lab::confusion_png::write(&p, &score)
                     .map_err(|e| format!("{}: {e}", p.display()))?;
                 println!("confusion matrix: {}", p.display());
             }
@@ -345,6 +364,14 @@ fn run(cli: Cli) -> Result<(), String> {
                     );
                 }
             }
+        }
+        Command::PoseEval {
+            scenarios,
+            minutes,
+            seed,
+        } => {
+            let rows = lab::pose_eval::table(seed, scenarios, minutes * 60.0);
+            print!("{}", lab::pose_eval::markdown(&rows));
         }
     }
     Ok(())

@@ -4,8 +4,8 @@ use models::train::{TrainConfig, emit_rust, read_csv, train};
 
 #[test]
 fn committed_tables_match_committed_data() {
-    let data = include_str!("../data/forest-train.csv");
-    let tables = include_str!("../src/forest_tables.rs");
+    let data = include_str!("../../models/data/forest-train.csv");
+    let tables = include_str!("../../models/src/forest_tables.rs");
     let object = models::forest::forest().object_frame;
     let d = read_csv(data, object).expect("training data parses");
     let t = train(
@@ -31,7 +31,7 @@ fn committed_tables_match_committed_data() {
 fn compiled_forest_agrees_with_its_training_data() {
     // Training accuracy of the compiled tables: far above chance, and the same call path the
     // runtime uses.
-    let data = include_str!("../data/forest-train.csv");
+    let data = include_str!("../../models/data/forest-train.csv");
     let f = models::forest::forest();
     let d = read_csv(data, f.object_frame).expect("training data parses");
     let right =

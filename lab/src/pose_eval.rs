@@ -17,10 +17,10 @@ use perception::pose::{
     HardIronFit, HeadingConfig, OdometryConfig, PoseFilter, TickCounter, integrate,
 };
 
-use crate::compass::{Compass, CompassConfig};
-use crate::dataset::scenario_seed;
-use crate::robot::{Motion, Robot, RobotConfig};
-use crate::world::{World, WorldConfig};
+use sim::compass::{Compass, CompassConfig};
+use sim::dataset::scenario_seed;
+use sim::robot::{Motion, Robot, RobotConfig};
+use sim::world::{World, WorldConfig};
 
 /// Sample period of encoders and compass, s (the vendor node's 50 ms).
 pub const SAMPLE_S: f32 = 0.05;

@@ -1,0 +1,21 @@
+//! # umbra lab
+//!
+//! umbra's workbench, for the host only and never flashed to a robot: Method A's training rows
+//! and forest, the evaluators of both methods against the simulator's truth, the pose-drift
+//! table and the figures the docs quote. It depends on the simulator, the models (with the
+//! forest trainer) and the perception core; nothing on the robot's path depends on it.
+//!
+//! | module            | owns                                                             |
+//! |-------------------|------------------------------------------------------------------|
+//! | [`scenes_a`]      | Method A run on simulated scenes, with truth labels for training and scoring |
+//! | [`eval_a`]        | Method A scored against the simulator's truth; forest training rows |
+//! | [`eval_b`]        | Method B scored on a dataset split: P, R, mAP50, mAP50-95 as Ultralytics does |
+//! | [`confusion_png`] | the evaluation's confusion matrix as a PNG                        |
+//! | [`pose_eval`]     | drift of odometry, compass overwrite and our fusion on the simulator |
+#![deny(unsafe_code, missing_docs)]
+
+pub mod confusion_png;
+pub mod eval_a;
+pub mod eval_b;
+pub mod pose_eval;
+pub mod scenes_a;
