@@ -11,7 +11,10 @@ use std::path::Path;
 
 use perception::pose::{HardIron, HardIronFit};
 
+use crate::cli::CalibrateArgs;
+use crate::launch::{EXIT_FAULT, EXIT_USAGE, Failure};
 use crate::odom::OdomRecord;
+use crate::reader::open_compass;
 
 /// Least heading coverage accepted, degrees.
 pub const MIN_COVERAGE_DEG: f32 = 270.0;
@@ -122,6 +125,81 @@ pub fn write_config(path: &Path, c: &Calibration) -> Result<(), String> {
     );
     let text = toml::to_string(&table).map_err(|e| e.to_string())?;
     std::fs::write(path, text).map_err(|e| format!("{}: {e}", path.display()))
+}
+
+/// `umbra calibrate-compass`: readings from a live compass (`--compass BUS`, turn the robot),
+/// a recorded spin (`--odom`), or the simulated robot's two-turn spin; the fit printed and,
+/// with `--write`, written into a configuration file.
+pub fn command(args: &CalibrateArgs) -> Result<(), Failure> {
+    let (xy, bad, source) = match (&args.odom, &args.compass) {
+        (_, Some(bus)) => {
+            let mut read = open_compass(bus).ok_or((
+                EXIT_FAULT,
+                format!("calibrate-compass: no compass on {bus}"),
+            ))?;
+            println!(
+                "umbra: turn the robot slowly in place, at least one full turn, for {} s…",
+                args.seconds
+            );
+            let mut xy = Vec::new();
+            let mut bad = 0;
+            let end = std::time::Instant::now() + std::time::Duration::from_secs_f64(args.seconds);
+            while std::time::Instant::now() < end {
+                match read() {
+                    Ok(m) => xy.push(m),
+                    Err(_) => bad += 1,
+                }
+                std::thread::sleep(std::time::Duration::from_millis(50));
+            }
+            (xy, bad, format!("{bus} (live, {} s)", args.seconds))
+        }
+        (Some(path), None) => {
+            let (xy, bad) = readings_from_file(path).map_err(|m| (EXIT_USAGE, m))?;
+            (xy, bad, path.display().to_string())
+        }
+        (None, None) => simulated_spin(args.seed)?,
+    };
+    let c = fit(&xy).map_err(|m| (EXIT_FAULT, format!("calibrate-compass: {m}")))?;
+    println!(
+        "umbra: compass calibration from {source}: {} readings ({bad} unreadable lines), {:.0}° covered; hard iron ({:.2}, {:.2}) µT, horizontal field {:.1} µT",
+        c.samples, c.coverage_deg, c.hard_iron.x_ut, c.hard_iron.y_ut, c.hard_iron.field_ut
+    );
+    match &args.write {
+        Some(path) => {
+            write_config(path, &c).map_err(|m| (EXIT_FAULT, m))?;
+            println!(
+                "umbra: wrote [compass] hard_iron_ut and field_reference_ut to {}",
+                path.display()
+            );
+        }
+        None => println!(
+            "[compass]\nhard_iron_ut = [{:.2}, {:.2}]\nfield_reference_ut = [{:.2}, {:.2}]",
+            c.hard_iron.x_ut, c.hard_iron.y_ut, c.hard_iron.field_ut, c.vertical_ut
+        ),
+    }
+    Ok(())
+}
+
+/// Compass readings of the simulated robot's two-turn spin, for `calibrate-compass` without a
+/// source.
+#[cfg(feature = "sim")]
+fn simulated_spin(seed: u64) -> Result<(Vec<[f32; 3]>, usize, String), Failure> {
+    let xy = sim::scenario::Scenario::new(seed, &sim::scenario::ScenarioConfig::standard())
+        .compass_spin_readings();
+    Ok((
+        xy,
+        0,
+        format!("the simulated robot (seed {seed}), two turns in place"),
+    ))
+}
+
+/// Built without the simulated robot: a source must be named.
+#[cfg(not(feature = "sim"))]
+fn simulated_spin(_seed: u64) -> Result<(Vec<[f32; 3]>, usize, String), Failure> {
+    Err((
+        EXIT_USAGE,
+        "calibrate-compass: name --odom or --compass (this umbra was built without the simulated robot, feature sim)".into(),
+    ))
 }
 
 #[cfg(test)]

@@ -1,8 +1,9 @@
-//! Command-line interface (`interfaces.md` §1).
+//! Command-line interface (`docs/interfaces.md` §1).
 
 use std::path::PathBuf;
 
 use clap::{Args, Parser, Subcommand, ValueEnum};
+use drivers::lidar::LidarModel;
 
 /// umbra: camera-free perception for small indoor robots.
 #[derive(Debug, Parser)]
@@ -59,24 +60,20 @@ pub struct CalibrateArgs {
     pub seed: u64,
 }
 
-/// LiDAR models (`--lidar-model`).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
-pub enum LidarModel {
-    /// Tell the model from the bytes (baud rates probed on a port; framing in a capture).
-    Auto,
-    /// ROBOTIS LDS-01 (HLS-LFCD2).
-    Lds01,
-    /// ROBOTIS LDS-02 (LDROBOT LD08).
-    Lds02,
-    /// LDROBOT LD06.
-    Ld06,
-    /// LDROBOT LD19.
-    Ld19,
-    /// Slamtec RPLIDAR A1.
-    RplidarA1,
-    /// Slamtec RPLIDAR A2.
-    RplidarA2,
+/// `--lidar-model`: `auto` (tell the model from the bytes: baud rates probed on a port,
+/// framing in a capture) or one of the drivers' models by its command-line name
+/// (`drivers::lidar::LidarModel::cli_name`).
+fn lidar_model_parser() -> impl clap::builder::TypedValueParser<Value = Named> {
+    use clap::builder::{PossibleValuesParser, TypedValueParser as _};
+    PossibleValuesParser::new(
+        std::iter::once("auto").chain(LidarModel::ALL.iter().map(|m| m.cli_name())),
+    )
+    .map(|name| Named(LidarModel::ALL.into_iter().find(|m| m.cli_name() == name)))
 }
+
+/// The LiDAR model `--lidar-model` names (`None` for `auto`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Named(pub Option<LidarModel>);
 
 /// Replay pacing (`--speed`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
@@ -92,8 +89,8 @@ pub enum Speed {
 #[derive(Debug, Args)]
 pub struct Common {
     /// Which LiDAR speaks on the port or in the capture.
-    #[arg(long, value_enum, default_value = "auto")]
-    pub lidar_model: LidarModel,
+    #[arg(long, value_name = "MODEL", default_value = "auto", value_parser = lidar_model_parser())]
+    pub lidar_model: Named,
     /// Write one JSON line per frame here (`-` = stdout).
     #[arg(long, value_name = "PATH")]
     pub jsonl: Option<String>,

@@ -4,7 +4,9 @@
 use std::io::{self, Write};
 
 use drivers::lidar::{LidarFaults, Revolution};
-use serde::Serialize;
+use perception::class::ObjectClass;
+use perception::fusion::{Evidence, FrameObject};
+use serde::{Serialize, Serializer};
 
 /// Pose in the map frame.
 #[derive(Debug, Clone, Copy, Serialize, Default, PartialEq)]
@@ -23,7 +25,8 @@ pub struct ObjectOut {
     /// Track id.
     pub id: u32,
     /// `chair`, `box`, `desk` or `door_frame`.
-    pub class: &'static str,
+    #[serde(serialize_with = "class_name")]
+    pub class: ObjectClass,
     /// Map-frame centre, m.
     pub x: f64,
     /// Map-frame centre, m.
@@ -31,10 +34,36 @@ pub struct ObjectOut {
     /// Confidence in [0, 1].
     pub score: f64,
     /// `A`, `B` or `AB`.
-    pub source: &'static str,
+    #[serde(serialize_with = "evidence_name")]
+    pub source: Evidence,
     /// Method B's box `[cx, cy, w, h]` in pixels of the 384 × 64 input (B and AB only).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub bbox: Option<[f64; 4]>,
+}
+
+impl ObjectOut {
+    /// A frame's object as the line carries it; `id` is its place in the frame's list.
+    pub fn new(id: usize, o: &FrameObject) -> Self {
+        ObjectOut {
+            id: id as u32,
+            class: o.class,
+            x: f64::from(o.centre.x),
+            y: f64::from(o.centre.y),
+            score: f64::from(o.score),
+            source: o.evidence,
+            bbox: o.bbox.map(|b| b.map(f64::from)),
+        }
+    }
+}
+
+/// The wire name of a class (`perception::class`'s names are the contract's).
+fn class_name<S: Serializer>(c: &ObjectClass, s: S) -> Result<S::Ok, S::Error> {
+    s.serialize_str(c.as_str())
+}
+
+/// The wire name of an object's evidence.
+fn evidence_name<S: Serializer>(e: &Evidence, s: S) -> Result<S::Ok, S::Error> {
+    s.serialize_str(e.as_str())
 }
 
 /// A wall segment.

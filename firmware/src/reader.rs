@@ -23,7 +23,32 @@ use std::time::{Duration, Instant};
 use drivers::opencr::OpencrReader;
 use drivers::serial::{LinkRead, SerialLink};
 
-use crate::runner::CompassReader;
+/// Reads the compass once; the error names the device. Runs on the device thread.
+pub type CompassReader = Box<dyn FnMut() -> Result<[f32; 3], String> + Send>;
+
+/// Opens an LSM303AGR on the I²C bus at `bus` (e.g. `/dev/i2c-1`); a failure is reported once
+/// and the runtime goes on without a compass.
+pub fn open_compass(bus: &str) -> Option<CompassReader> {
+    let i2c = match linux_embedded_hal::I2cdev::new(bus) {
+        Ok(i2c) => i2c,
+        Err(e) => {
+            log::warn!("--compass {bus}: cannot open the I2C bus ({e}); running without a compass");
+            return None;
+        }
+    };
+    match drivers::compass::Lsm303Compass::new(i2c, linux_embedded_hal::Delay) {
+        Ok(mut c) => {
+            let bus = bus.to_owned();
+            Some(Box::new(move || {
+                c.read_ut().map_err(|e| format!("--compass {bus}: {e}"))
+            }))
+        }
+        Err(e) => {
+            log::warn!("--compass {bus}: no LSM303AGR answers ({e}); running without a compass");
+            None
+        }
+    }
+}
 
 /// Bytes one chunk holds (a LiDAR read returns what is there, usually far less).
 pub const CHUNK_BYTES: usize = 512;

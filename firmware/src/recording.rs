@@ -1,5 +1,5 @@
 //! Replay of umbra's own MCAP recordings (`interfaces.md` §2): `umbra replay RUN.mcap` reads
-//! back what `--record` wrote for it ([`crate::viz`]): the LiDAR's bytes exactly as read
+//! back what `--record` wrote for it ([`crate::viz`], channels in [`crate::record_format`]): the LiDAR's bytes exactly as read
 //! (`/umbra/lidar_raw`) and every encoder/compass sample the pose filter was fed
 //! (`/umbra/odometry`, each with the frame at which it became available), then runs them
 //! through the same pipeline as the recorded run: the bytes as a capture, each sample made
@@ -11,7 +11,7 @@ use std::path::{Path, PathBuf};
 use drivers::lidar::LidarModel;
 
 use crate::odom::OdomRecord;
-use crate::viz::{ODOM_TOPIC, RAW_TOPIC, RecordedSample};
+use crate::record_format::{ODOM_TOPIC, RAW_TOPIC, RecordedSample};
 
 /// The first bytes of every MCAP file.
 pub const MCAP_MAGIC: &[u8] = b"\x89MCAP0\r\n";

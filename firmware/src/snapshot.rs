@@ -5,11 +5,14 @@
 //! picture is a few hundred shapes, and SVG keeps labels as text a browser can search.
 
 use std::fmt::Write as _;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use perception::geometry::{Point2, Pose2};
 
+use perception::class::ObjectClass;
+
 use crate::output::{DoorOut, ObjectOut, WallOut};
+use crate::sink::{FrameSink, FrameView, RunEnd};
 
 /// What the snapshot draws.
 #[derive(Debug, Clone, Copy)]
@@ -33,13 +36,12 @@ const SCALE: f64 = 80.0;
 /// Margin around the content, m.
 const MARGIN_M: f64 = 0.6;
 
-fn class_colour(class: &str) -> &'static str {
+fn class_colour(class: ObjectClass) -> &'static str {
     match class {
-        "chair" => "#e69f00",
-        "box" => "#56b4e9",
-        "desk" => "#009e73",
-        "door_frame" => "#cc79a7",
-        _ => "#999999",
+        ObjectClass::Chair => "#e69f00",
+        ObjectClass::Box => "#56b4e9",
+        ObjectClass::Desk => "#009e73",
+        ObjectClass::DoorFrame => "#cc79a7",
     }
 }
 
@@ -157,9 +159,9 @@ pub fn svg(scene: &Scene<'_>) -> String {
             r#"<text x="{:.1}" y="{:.1}" fill="{c}">{} {:.2} {}</text>"#,
             x + 10.0,
             y - 10.0,
-            escape(o.class),
+            o.class,
             o.score,
-            escape(o.source)
+            o.source.as_str()
         );
     }
     let _ = writeln!(s, "</g>");
@@ -203,6 +205,37 @@ pub fn write(path: &Path, scene: &Scene<'_>) -> Result<(), String> {
     std::fs::write(path, svg(scene)).map_err(|e| format!("--snapshot {}: {e}", path.display()))
 }
 
+/// Draws the run's last frame when it ends (`--snapshot`); a write error is logged, not fatal.
+pub struct SnapshotSink(pub PathBuf);
+
+impl FrameSink for SnapshotSink {
+    fn frame(&mut self, _f: &FrameView<'_>) -> std::io::Result<bool> {
+        Ok(false)
+    }
+    fn finish(&mut self, end: &RunEnd<'_>) -> std::io::Result<()> {
+        let caption = format!(
+            "umbra, frame {}, t {:.1} s: {} objects, {} walls, {} doors",
+            end.frames.saturating_sub(1),
+            end.sensor_seconds,
+            end.objects.len(),
+            end.walls.len(),
+            end.doors.len()
+        );
+        let scene = Scene {
+            cloud: end.cloud,
+            robot: end.robot,
+            walls: end.walls,
+            doors: end.doors,
+            objects: end.objects,
+            caption: &caption,
+        };
+        if let Err(e) = write(&self.0, &scene) {
+            log::error!("{e}");
+        }
+        Ok(())
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -224,11 +257,11 @@ mod tests {
         }];
         let objects = [ObjectOut {
             id: 0,
-            class: "chair",
+            class: ObjectClass::Chair,
             x: 1.5,
             y: 0.4,
             score: 0.97,
-            source: "A",
+            source: perception::fusion::Evidence::A,
             bbox: None,
         }];
         let s = svg(&Scene {

@@ -33,23 +33,22 @@ use foxglove::schemas::{
     line_primitive,
 };
 use foxglove::{Channel, ChannelBuilder, Context, RawChannel, Schema};
+use perception::class::ObjectClass;
 use perception::geometry::Pose2;
 use perception::raster::SCAN_COLUMNS;
 
 use crate::odom::OdomRecord;
 use crate::output::{DoorOut, ObjectOut, WallOut};
+use crate::record_format::{
+    ODOM_SCHEMA, ODOM_TOPIC, RAW_ENCODING, RAW_TOPIC, RECORD_RAW_BYTES, RecordedSample,
+};
+use crate::sink::{FrameSink, FrameView, RunEnd};
 
-/// LiDAR bytes a frame carries to the recording: 16 KiB, over six LDS-01 revolutions, so a
-/// frame's bytes fit even when the viz thread was behind for a few frames.
-pub const RAW_BYTES: usize = crate::runner::RECORD_RAW_BYTES;
+/// LiDAR bytes a frame carries to the recording ([`RECORD_RAW_BYTES`]), so a frame's bytes fit
+/// even when the viz thread was behind for a few frames.
+pub const RAW_BYTES: usize = RECORD_RAW_BYTES;
 /// Encoder/compass samples a frame carries to the recording (20 Hz: 4 a frame).
 pub const VIZ_ODOM: usize = crate::odom::JOURNAL_LEN;
-/// Topic of the LiDAR's raw bytes.
-pub const RAW_TOPIC: &str = "/umbra/lidar_raw";
-/// Topic of the odometry samples.
-pub const ODOM_TOPIC: &str = "/umbra/odometry";
-/// Message encoding of the raw bytes.
-pub const RAW_ENCODING: &str = "application/octet-stream";
 
 /// Objects a frame carries to the viz thread.
 pub const VIZ_OBJECTS: usize = 64;
@@ -241,6 +240,66 @@ impl VizLink {
     }
 }
 
+/// Recording and the live view as a frame sink: each frame is copied into a pooled
+/// [`VizFrame`] with the LiDAR bytes and odometry read since the last one it took.
+pub struct VizSink(Option<VizLink>);
+
+impl VizSink {
+    /// A sink over a started link.
+    pub fn new(link: VizLink) -> Self {
+        VizSink(Some(link))
+    }
+}
+
+impl FrameSink for VizSink {
+    fn frame(&mut self, f: &FrameView<'_>) -> std::io::Result<bool> {
+        let Some(link) = self.0.as_mut() else {
+            return Ok(false);
+        };
+        Ok(link.send(|v| {
+            v.raw.clear();
+            let _ = v
+                .raw
+                .extend_from_slice(&f.raw[..f.raw.len().min(RAW_BYTES)]);
+            v.odom.clear();
+            for r in f.odom {
+                let _ = v.odom.push(*r);
+            }
+            v.frame = f.line.frame;
+            v.t = f.line.t;
+            v.pose = f.pose;
+            v.mount = f.mount;
+            v.ranges.copy_from_slice(f.ranges);
+            v.objects.clear();
+            v.walls.clear();
+            v.doors.clear();
+            for o in f.line.objects {
+                let _ = v.objects.push(o.clone());
+            }
+            for w in f.line.walls {
+                let _ = v.walls.push(w.clone());
+            }
+            for d in f.line.doors {
+                let _ = v.doors.push(d.clone());
+            }
+        }))
+    }
+    fn finish(&mut self, _end: &RunEnd<'_>) -> std::io::Result<()> {
+        if let Some(link) = self.0.take()
+            && let Err(e) = link.finish()
+        {
+            log::error!("{e}");
+        }
+        Ok(())
+    }
+    fn dropped(&self) -> u64 {
+        self.0.as_ref().map_or(0, VizLink::dropped)
+    }
+    fn records_input(&self) -> bool {
+        self.0.is_some()
+    }
+}
+
 impl Drop for VizLink {
     fn drop(&mut self) {
         self.to_thread = None;
@@ -258,20 +317,6 @@ struct Channels {
     raw: Arc<RawChannel>,
     odom: Arc<RawChannel>,
 }
-
-/// An `/umbra/odometry` message: the `--odom` object of `interfaces.md` §2 plus the frame at
-/// which the sample became available to the pose (replay makes it available at that frame).
-#[derive(Debug, Clone, Copy, serde::Serialize, serde::Deserialize)]
-pub struct RecordedSample {
-    /// The frame.
-    pub frame: u64,
-    /// The sample.
-    #[serde(flatten)]
-    pub sample: OdomRecord,
-}
-
-/// The JSON Schema of an `/umbra/odometry` message (the `--odom` line of `interfaces.md` §2).
-const ODOM_SCHEMA: &str = r#"{"type":"object","required":["t","frame"],"properties":{"frame":{"type":"integer"},"t":{"type":"number"},"left_ticks":{"type":["integer","null"]},"right_ticks":{"type":["integer","null"]},"mag_ut":{"type":["array","null"],"items":{"type":"number"},"minItems":3,"maxItems":3}}}"#;
 
 fn ts(t: f64) -> Option<Timestamp> {
     Some(Timestamp::saturating_from_epoch_secs_f64(t.max(0.0)))
@@ -294,13 +339,12 @@ fn yaw(theta: f64) -> Quaternion {
 }
 
 /// Colour of a class (Okabe–Ito, readable by colour-blind viewers).
-fn colour(class: &str) -> Color {
+fn colour(class: ObjectClass) -> Color {
     let (r, g, b) = match class {
-        "chair" => (0.90, 0.62, 0.0),
-        "box" => (0.34, 0.71, 0.91),
-        "desk" => (0.0, 0.62, 0.45),
-        "door_frame" => (0.80, 0.47, 0.65),
-        _ => (0.6, 0.6, 0.6),
+        ObjectClass::Chair => (0.90, 0.62, 0.0),
+        ObjectClass::Box => (0.34, 0.71, 0.91),
+        ObjectClass::Desk => (0.0, 0.62, 0.45),
+        ObjectClass::DoorFrame => (0.80, 0.47, 0.65),
     };
     Color { r, g, b, a: 0.8 }
 }
@@ -419,7 +463,7 @@ impl Channels {
                         y: d.width,
                         z: 2.0,
                     }),
-                    color: Some(colour("door_frame")),
+                    color: Some(colour(ObjectClass::DoorFrame)),
                 }))
                 .collect(),
             texts: f
@@ -436,7 +480,7 @@ impl Channels {
                         b: 1.0,
                         a: 1.0,
                     }),
-                    text: format!("{} {:.2} {}", o.class, o.score, o.source),
+                    text: format!("{} {:.2} {}", o.class, o.score, o.source.as_str()),
                 })
                 .collect(),
             lines: vec![LinePrimitive {

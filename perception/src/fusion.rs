@@ -14,9 +14,8 @@ use crate::geometry::Point2;
 pub const AGREE_M: f32 = 0.3;
 
 /// Objects one frame can carry: every Method A candidate, every door, every B box.
-pub const MAX_FRAME_OBJECTS: usize = crate::method_a::MAX_CANDIDATES
-    + crate::doors::MAX_DOORS
-    + crate::yolo::MAX_DETECTIONS;
+pub const MAX_FRAME_OBJECTS: usize =
+    crate::method_a::MAX_CANDIDATES + crate::doors::MAX_DOORS + crate::yolo::MAX_DETECTIONS;
 
 /// Which methods saw an object.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -135,8 +134,18 @@ mod test {
     #[test]
     fn a_box_near_an_object_of_its_class_agrees_with_the_nearest() {
         let mut o = FrameObjects::new();
-        assert!(push_a(&mut o, ObjectClass::Chair, Point2::new(1.0, 0.0), 0.6));
-        assert!(push_a(&mut o, ObjectClass::Chair, Point2::new(1.2, 0.0), 0.5));
+        assert!(push_a(
+            &mut o,
+            ObjectClass::Chair,
+            Point2::new(1.0, 0.0),
+            0.6
+        ));
+        assert!(push_a(
+            &mut o,
+            ObjectClass::Chair,
+            Point2::new(1.2, 0.0),
+            0.5
+        ));
         assert!(merge_b(&mut o, &placed(ObjectClass::Chair, 1.15, 0.0, 0.9)));
         assert_eq!(o.len(), 2);
         assert_eq!(o[0].evidence, Evidence::A);
@@ -155,8 +164,14 @@ mod test {
         merge_b(&mut o, &placed(ObjectClass::Desk, 0.31, 0.0, 0.4));
         assert_eq!(o.len(), 3);
         assert_eq!(o[0].evidence, Evidence::A);
-        assert_eq!((o[1].class, o[1].evidence), (ObjectClass::Chair, Evidence::B));
-        assert_eq!((o[2].class, o[2].evidence), (ObjectClass::Desk, Evidence::B));
+        assert_eq!(
+            (o[1].class, o[1].evidence),
+            (ObjectClass::Chair, Evidence::B)
+        );
+        assert_eq!(
+            (o[2].class, o[2].evidence),
+            (ObjectClass::Desk, Evidence::B)
+        );
         // An agreed object keeps the higher of the two scores.
         merge_b(&mut o, &placed(ObjectClass::Desk, 0.1, 0.0, 0.3));
         assert_eq!((o[0].evidence, o[0].score), (Evidence::AB, 0.8));
@@ -177,7 +192,12 @@ mod test {
         for _ in 0..MAX_FRAME_OBJECTS {
             assert!(push_a(&mut o, ObjectClass::Box, Point2::new(9.0, 9.0), 0.5));
         }
-        assert!(!push_a(&mut o, ObjectClass::Box, Point2::new(9.0, 9.0), 0.5));
+        assert!(!push_a(
+            &mut o,
+            ObjectClass::Box,
+            Point2::new(9.0, 9.0),
+            0.5
+        ));
         assert!(!merge_b(&mut o, &placed(ObjectClass::Chair, 0.0, 0.0, 0.5)));
         // Agreement needs no room.
         assert!(merge_b(&mut o, &placed(ObjectClass::Box, 9.0, 9.0, 0.7)));

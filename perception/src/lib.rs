@@ -19,6 +19,7 @@
 //! | [`features`]   | the 9-D feature vector, in the object's frame or the map's |
 //! | [`method_a`]   | the geometric pipeline end to end, classifier as a parameter |
 //! | [`yolo`]       | Method B's output: YOLOv8 decode, suppression, map-frame centres |
+//! | [`fusion`]     | one frame's objects from both methods: A's, and B's joined or added |
 //!
 //! Each capacity is a named constant listed in
 //! `memory-budget.md`.
@@ -30,6 +31,7 @@ pub mod cloud;
 pub mod dbscan;
 pub mod doors;
 pub mod features;
+pub mod fusion;
 pub mod geometry;
 pub mod merge;
 pub mod method_a;

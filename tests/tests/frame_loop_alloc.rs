@@ -1,5 +1,5 @@
 //! The whole frame loop (`firmware::runner::run`: ingest → pose → Method A → Method B → JSON
-//! line, deadline histograms, overrun policy, power model) allocates nothing per frame after
+//! line and statistics sinks, deadline histograms, overrun policy, power model) allocates nothing per frame after
 //! warm-up, outside tract; with Method B on, the per-frame count is tract's constant. A counting
 //! global allocator watches the loop's thread; the JSON sink marks the count at every line.
 
@@ -8,10 +8,12 @@ use std::sync::Arc;
 use std::sync::atomic::AtomicBool;
 
 use firmware::config::Config;
-use firmware::odom::PoseState;
+use firmware::odom::{PoseInput, PoseState};
 use firmware::power::PowerMeter;
-use firmware::runner::{self, MethodBSetup, PoseInput, RunOptions, SecondsClock};
+use firmware::runner::{self, MethodBSetup, RunOptions, SecondsClock};
+use firmware::sink::{FrameSink, JsonlSink, StatsSink};
 use firmware::source::{LidarSource, Pacing};
+use firmware::viz::{VizLink, VizSink};
 use umbra_tests::{allocations, counted};
 
 #[global_allocator]
@@ -41,7 +43,7 @@ fn per_frame(method_b: bool) -> Vec<u64> {
     per_frame_with(method_b, None)
 }
 
-fn per_frame_with(method_b: bool, viz: Option<runner::VizLink>) -> Vec<u64> {
+fn per_frame_with(method_b: bool, viz: Option<VizLink>) -> Vec<u64> {
     let cfg = Config::default();
     let source = LidarSource::sim(3, 3);
     let cal = source.sim_calibration();
@@ -53,18 +55,25 @@ fn per_frame_from(
     mut source: LidarSource,
     pose: PoseInput,
     method_b: bool,
-    viz: Option<runner::VizLink>,
+    viz: Option<VizLink>,
 ) -> Vec<u64> {
     let cfg = Config::default();
     let marks = Arc::new(std::sync::Mutex::new(Vec::with_capacity(
         FRAMES as usize + 8,
     )));
     let b = method_b.then(|| MethodBSetup {
-        model: models::yolo::YoloModel::builtin(Default::default()).expect("model"),
+        model: Box::new(models::yolo::YoloModel::builtin(Default::default()).expect("model")),
         raster: cfg.method_b_raster(),
         decode: cfg.method_b_decode(),
         mount: cfg.lidar_mount(),
     });
+    let mut sinks: Vec<Box<dyn FrameSink>> = vec![
+        Box::new(JsonlSink(Box::new(Marks(marks.clone())))),
+        Box::new(StatsSink(Box::new(std::io::sink()))),
+    ];
+    if let Some(link) = viz {
+        sinks.push(Box::new(VizSink::new(link)));
+    }
     let opts = RunOptions {
         frames: Some(FRAMES),
         seconds: None,
@@ -73,14 +82,11 @@ fn per_frame_from(
         budgets: cfg.budgets(),
         power: Some(PowerMeter::model(&cfg.power, None)),
         power_budget_w: cfg.power.budget_w,
-        jsonl: Some(Box::new(Marks(marks.clone()))),
-        stats: Some(Box::new(std::io::sink())),
+        sinks,
         stop: Arc::new(AtomicBool::new(false)),
         pose: Some(pose),
         method_a: Some((cfg.method_a(), cfg.lidar_mount())),
         method_b: b,
-        viz,
-        snapshot: None,
     };
     let mut summary = None;
     let stream = drivers::lidar::AnyLidar::new(source.model().expect("a LiDAR"), &cfg.lidar());
@@ -119,7 +125,7 @@ fn recording_costs_the_loop_no_allocation() {
     // The viz thread converts and writes (and allocates) on its own; the loop only fills
     // pooled frames (results, the raw LiDAR bytes and the odometry samples for replay).
     let path = std::env::temp_dir().join(format!("umbra-alloc-{}.mcap", std::process::id()));
-    let link = runner::VizLink::start(&firmware::viz::VizTargets {
+    let link = VizLink::start(&firmware::viz::VizTargets {
         record: Some(path.clone()),
         live: None,
         meta: Default::default(),
@@ -181,7 +187,7 @@ fn serial_source_with_reader_threads_allocates_nothing_after_warm_up() {
     .expect("open the pty");
     let cfg = Config::default();
     let mut pose = PoseInput::new(PoseState::new(cfg.pose_filter(None), false));
-    let compass: runner::CompassReader = Box::new(|| Ok([21.5, -3.2, 40.1]));
+    let compass: firmware::reader::CompassReader = Box::new(|| Ok([21.5, -3.2, 40.1]));
     pose.devices = Some(firmware::reader::DeviceReader::start(None, Some(compass)).unwrap());
     let d = per_frame_from(source, pose, false, None);
     stop.store(true, std::sync::atomic::Ordering::Relaxed);

@@ -164,8 +164,8 @@ fn buffers_in_code() -> Vec<(&'static str, usize, usize)> {
             size_of::<firmware::viz::VizFrame>(),
         ),
         (
-            "firmware::runner::RECORD_RAW_BYTES",
-            firmware::runner::RECORD_RAW_BYTES,
+            "firmware::record_format::RECORD_RAW_BYTES",
+            firmware::record_format::RECORD_RAW_BYTES,
             1,
         ),
         (
@@ -184,8 +184,8 @@ fn buffers_in_code() -> Vec<(&'static str, usize, usize)> {
             size_of::<firmware::reader::DeviceSample>(),
         ),
         (
-            "firmware::runner::POSE_QUEUE",
-            firmware::runner::POSE_QUEUE,
+            "firmware::odom::POSE_QUEUE",
+            firmware::odom::POSE_QUEUE,
             size_of::<firmware::odom::OdomRecord>(),
         ),
         (

@@ -3,6 +3,9 @@
 //! in step with the LiDAR frames on the same clock, or samples handed over by the simulated
 //! robot. Both feed one [`PoseFilter`].
 //!
+//! [`PoseInput`] (`input.rs`) feeds the filter in step with the frames from whichever source
+//! the run has.
+//!
 //! A line that is not valid JSON, or a sample with fields of the wrong type, is counted as an
 //! encoder error and skipped; the run goes on.
 
@@ -12,6 +15,9 @@ use std::path::{Path, PathBuf};
 
 use perception::pose::PoseFilter;
 use serde::{Deserialize, Serialize};
+
+mod input;
+pub use input::{FramePose, ODOM_QUEUE, POSE_QUEUE, PoseInput};
 
 /// One sample.
 #[derive(Debug, Clone, Copy, PartialEq, Deserialize, Serialize)]

@@ -1,0 +1,408 @@
+//! One frame through the pipeline: the revolution's readings and the pose over it, Method A
+//! on the global cloud, Method B on the last three revolutions (unless the overrun policy
+//! sheds it), the fusion of both (`perception::fusion`), the stage times and the power, then
+//! every sink. Everything here is allocated at start-up ([`FrameState::new`]).
+
+use std::io;
+use std::time::{Duration, Instant};
+
+use perception::cloud::Scan;
+use perception::fusion::{FrameObjects, merge_b, push_a};
+use perception::geometry::{Point2, Pose2};
+use perception::method_a::{MethodA, MethodAConfig};
+
+use super::FrameLoop;
+use super::history::ScanHistory;
+use super::method_b::MethodBScratch;
+use crate::deadline::{DeadlineRecord, FrameTimes, Policy, SHRINK_DROP_FRACTION};
+use crate::frames::FrameStream;
+use crate::odom::{FramePose, PoseInput};
+use crate::output::{
+    DoorOut, FaultsOut, LidarOut, ObjectOut, OutputLine, PoseOut, TimingOut, WallOut,
+};
+use crate::record_format::RECORD_RAW_BYTES;
+use crate::sink::FrameView;
+use crate::source::{LidarSource, Pacing};
+
+/// What the loop keeps between frames, allocated once at start-up.
+pub(super) struct FrameState {
+    pub(super) method_a: Box<MethodA>,
+    /// The last three revolutions; Method A reads the newest, Method B all three.
+    history: Box<ScanHistory>,
+    b_scratch: MethodBScratch,
+    /// This frame's objects from both methods.
+    fused: Box<FrameObjects>,
+    method_b_errors: u64,
+    /// Host time spent in frames (taken off the link clock).
+    pub(super) busy: Duration,
+    /// The overrun policy's memory.
+    policy: Policy,
+    /// Stage histograms and counters.
+    pub(super) record: DeadlineRecord,
+    /// Time it took the sinks to take the previous frame, ms.
+    last_output_ms: f64,
+    /// The pose of the last frame.
+    pub(super) last_pose: Pose2,
+    /// Sum, count and peak of the power figures.
+    pub(super) power_sum: f64,
+    pub(super) power_n: u64,
+    pub(super) power_peak: f64,
+    pub(super) objects: Vec<ObjectOut>,
+    pub(super) walls: Vec<WallOut>,
+    pub(super) doors: Vec<DoorOut>,
+    /// While recording: the LiDAR bytes read since the recorder last took them.
+    recording: Option<RecordingInput>,
+}
+
+/// LiDAR bytes waiting for the recorder.
+struct RecordingInput {
+    raw: Box<heapless::Vec<u8, RECORD_RAW_BYTES>>,
+    /// Bytes that did not fit (missing from the recording).
+    dropped: u64,
+}
+
+impl FrameState {
+    /// Everything the loop needs, allocated now; `recording`: keep the LiDAR's bytes for a
+    /// recorder.
+    pub(super) fn new(recording: bool) -> Self {
+        FrameState {
+            method_a: Box::new(MethodA::new()),
+            history: Box::default(),
+            b_scratch: MethodBScratch::default(),
+            fused: Box::default(),
+            method_b_errors: 0,
+            busy: Duration::ZERO,
+            policy: Policy::default(),
+            record: DeadlineRecord::default(),
+            last_output_ms: 0.0,
+            last_pose: Pose2::IDENTITY,
+            power_sum: 0.0,
+            power_n: 0,
+            power_peak: 0.0,
+            objects: Vec::with_capacity(perception::fusion::MAX_FRAME_OBJECTS),
+            walls: Vec::with_capacity(perception::walls::MAX_SEGMENTS),
+            doors: Vec::with_capacity(perception::doors::MAX_DOORS),
+            recording: recording.then(|| RecordingInput {
+                raw: Box::new(heapless::Vec::new()),
+                dropped: 0,
+            }),
+        }
+    }
+
+    /// Keeps bytes just read for the recorder (counted when they do not fit).
+    pub(super) fn note_raw(&mut self, bytes: &[u8]) {
+        let Some(r) = self.recording.as_mut() else {
+            return;
+        };
+        let n = bytes.len();
+        let take = n.min(r.raw.capacity() - r.raw.len());
+        let _ = r.raw.extend_from_slice(&bytes[..take]);
+        if take < n {
+            if r.dropped == 0 {
+                log::warn!(
+                    "recording: the recorder is behind; LiDAR bytes dropped from the recording (counted)"
+                );
+            }
+            r.dropped += (n - take) as u64;
+        }
+    }
+
+    /// Method A on the newest revolution: cloud, clusters, walls, doors, classes. Its objects
+    /// and doors (as door frames) open the frame's object list.
+    fn method_a(&mut self, cfg: &MethodAConfig, mount: &Pose2, shrink: bool, pose: &FramePose) {
+        // Overrun policy step 2: age more of the cloud so clustering sees fewer points.
+        let mut shrunk;
+        let cfg = if shrink {
+            shrunk = *cfg;
+            shrunk.cloud.drop_fraction = shrunk.cloud.drop_fraction.max(SHRINK_DROP_FRACTION);
+            &shrunk
+        } else {
+            cfg
+        };
+        let m = &mut self.method_a;
+        m.add_scan(
+            &Scan {
+                ranges: self.history.pending(),
+                start: pose.start,
+                end: pose.end,
+                mount: *mount,
+            },
+            cfg,
+        );
+        let sensor = pose.end.compose(mount);
+        m.run(
+            Point2::new(sensor.x, sensor.y),
+            cfg,
+            models::forest::forest(),
+        );
+        for (class, c) in m.objects() {
+            push_a(&mut self.fused, class, c.centre, c.score);
+        }
+        for s in m.segments() {
+            self.walls.push(WallOut {
+                x0: f64::from(s.a.x),
+                y0: f64::from(s.a.y),
+                x1: f64::from(s.b.x),
+                y1: f64::from(s.b.y),
+            });
+        }
+        for d in m.doors() {
+            self.doors.push(DoorOut {
+                x: f64::from(d.centre.x),
+                y: f64::from(d.centre.y),
+                width: f64::from(d.width),
+                score: f64::from(d.score),
+            });
+            push_a(
+                &mut self.fused,
+                perception::class::ObjectClass::DoorFrame,
+                d.centre,
+                d.score,
+            );
+        }
+    }
+
+    /// Method B on the last three revolutions; its boxes join the frame's objects. A failed
+    /// frame is counted (and said once) and the frame goes on without it.
+    fn method_b(&mut self, b: &mut super::MethodBSetup) {
+        let Some((scans, middle)) = self.history.three() else {
+            return;
+        };
+        let fused = &mut self.fused;
+        if let Err(e) = b.frame(scans, middle, &mut self.b_scratch, |placed| {
+            merge_b(fused, &placed);
+        }) {
+            if self.method_b_errors == 0 {
+                log::warn!("Method B: {e}; frame goes on without it (counted)");
+            }
+            self.method_b_errors += 1;
+        }
+    }
+}
+
+impl<S: FrameStream> FrameLoop<'_, S> {
+    /// Hands the stream's last finished revolution out as one frame; `true` when the frame
+    /// limit is reached.
+    pub(super) fn emit_frame(&mut self) -> io::Result<bool> {
+        let FrameLoop {
+            source,
+            stream,
+            opts,
+            st,
+            summary,
+            ingest,
+            start,
+        } = self;
+        let Some(rev) = stream.last_revolution() else {
+            return Ok(false);
+        };
+        let t_frame = Instant::now();
+        let frame = summary.frames;
+        let valid = rev.valid_count() as u32;
+        summary.frames += 1;
+        if rev.is_complete() {
+            summary.complete += 1;
+        }
+        summary.invalid_readings += (u64::from(rev.packets)
+            * drivers::lidar::revolution::BINS_PER_SECTOR as u64)
+            .saturating_sub(u64::from(valid));
+
+        // Pose: at the first ray and at the last (359/360 of a revolution later).
+        let t = rev.first_ray_time_s().max(0.0);
+        let t_pose = Instant::now();
+        let period = if rev.period_s.is_finite() && rev.period_s > 0.0 && rev.period_s < 2.0 {
+            f64::from(rev.period_s)
+        } else {
+            0.2
+        };
+        let t_end = t + period * 359.0 / 360.0;
+        let pose = opts
+            .pose
+            .as_mut()
+            .map_or(FramePose::STILL, |p: &mut PoseInput| {
+                p.frame(frame, t, t_end, *start)
+            });
+        let pose_ms = t_pose.elapsed().as_secs_f64() * 1e3;
+
+        // Method A.
+        let t_a = Instant::now();
+        st.fused.clear();
+        st.walls.clear();
+        st.doors.clear();
+        for (r, reading) in st.history.next_mut().iter_mut().zip(rev.readings.iter()) {
+            *r = if reading.valid { reading.range_m } else { 0.0 };
+        }
+        let shrink = opts.method_a.is_some() && st.policy.before_method_a(&opts.budgets);
+        let method_a_ms = opts.method_a.as_ref().map(|(cfg, mount)| {
+            st.method_a(cfg, mount, shrink, &pose);
+            let ms = t_a.elapsed().as_secs_f64() * 1e3;
+            st.policy.method_a_took(ms);
+            ms
+        });
+        st.history.commit(midway(&pose.start, &pose.end));
+
+        // Method B, unless the overrun policy sheds it (no room left, or decimated while
+        // behind the LiDAR).
+        let backlog_bytes = source.backlog_bytes();
+        let behind = behind_lidar(source, backlog_bytes, opts.pacing, stream, start, period);
+        let elapsed_ms = ingest.as_secs_f64() * 1e3 + t_frame.elapsed().as_secs_f64() * 1e3;
+        let run_b = opts.method_b.is_some() && st.history.revolutions() >= 3;
+        let skip_b = run_b && st.policy.before_method_b(&opts.budgets, elapsed_ms, behind);
+        let method_b_ms = match opts.method_b.as_mut() {
+            Some(b) if run_b && !skip_b => {
+                let t_b = Instant::now();
+                st.method_b(b);
+                let ms = t_b.elapsed().as_secs_f64() * 1e3;
+                st.policy.method_b_took(ms);
+                Some(ms)
+            }
+            _ => None,
+        };
+
+        // The frame's objects: ids are places in this frame's list.
+        st.objects.clear();
+        for (id, o) in st.fused.iter().enumerate() {
+            st.objects.push(ObjectOut::new(id, o));
+        }
+
+        // Times, the deadline, the power.
+        let ingest_ms = ingest.as_secs_f64() * 1e3;
+        let output_ms = st.last_output_ms;
+        let total_ms = ingest_ms + t_frame.elapsed().as_secs_f64() * 1e3 + output_ms;
+        let missed = total_ms > opts.budgets.deadline_ms;
+        let degraded = skip_b || shrink;
+        let rec = &mut st.record;
+        rec.method_b_skipped += u64::from(skip_b);
+        rec.cloud_shrunk += u64::from(shrink);
+        rec.behind_lidar += u64::from(behind);
+        let times = FrameTimes {
+            ingest: ingest_ms,
+            pose: pose_ms,
+            method_a: method_a_ms,
+            method_b: method_b_ms,
+            output: output_ms,
+            total: total_ms,
+        };
+        rec.record(&times, &opts.budgets, missed, degraded);
+        let power_w = opts.power.as_mut().and_then(|p| p.watts());
+        if let Some(w) = power_w {
+            st.power_sum += w;
+            st.power_n += 1;
+            st.power_peak = st.power_peak.max(w);
+        }
+
+        // Outputs.
+        let t_out = Instant::now();
+        let rec = &st.record;
+        let journal = opts.pose.as_ref().and_then(|p| p.state.journal.as_ref());
+        let view = FrameView {
+            rev,
+            mount: match (&opts.method_a, &opts.method_b) {
+                (Some((_, m)), _) => *m,
+                (None, Some(b)) => b.mount,
+                (None, None) => Pose2::IDENTITY,
+            },
+            ranges: st.history.newest(),
+            pose: pose.start,
+            raw: st.recording.as_ref().map_or(&[], |r| &r.raw[..]),
+            odom: journal.map_or(&[], |j| &j[..]),
+            line: OutputLine {
+                frame,
+                t,
+                pose: PoseOut {
+                    x: f64::from(pose.start.x),
+                    y: f64::from(pose.start.y),
+                    theta: f64::from(pose.start.theta),
+                },
+                objects: &st.objects,
+                walls: &st.walls,
+                doors: &st.doors,
+                timing_ms: TimingOut::from(times),
+                deadline_ms: opts.budgets.deadline_ms,
+                deadline_missed: missed,
+                degraded,
+                power_w,
+                power_source: opts.power.as_ref().map_or("none", |p| p.source()),
+                faults: FaultsOut {
+                    encoder_errors: pose.encoder_errors,
+                    compass_rejected: pose.compass_rejected,
+                    compass_errors: pose.compass_errors,
+                    method_b_errors: st.method_b_errors,
+                    deadline_missed: rec.missed,
+                    degraded_frames: rec.degraded,
+                    method_b_skipped: rec.method_b_skipped,
+                    cloud_shrunk: rec.cloud_shrunk,
+                    behind_lidar: rec.behind_lidar,
+                    recording_bytes_dropped: st.recording.as_ref().map_or(0, |r| r.dropped),
+                    recording_samples_dropped: opts
+                        .pose
+                        .as_ref()
+                        .map_or(0, |p| p.state.journal_dropped),
+                    odometry_dropped: opts.pose.as_ref().map_or(0, PoseInput::odometry_dropped),
+                    ..FaultsOut::new(
+                        &stream.faults(),
+                        summary.invalid_readings,
+                        source.link_counts(),
+                    )
+                },
+                lidar: LidarOut {
+                    rpm: f64::from(rev.rpm),
+                    packets: rev.packets,
+                    valid,
+                    backlog_bytes,
+                    queue_chunks: source.queue_depth().map(|q| q.0),
+                    queue_chunks_max: source.queue_depth().map(|q| q.1),
+                },
+            },
+        };
+        let mut taken = false;
+        for sink in opts.sinks.iter_mut() {
+            taken |= sink.frame(&view)?;
+        }
+        st.last_output_ms = t_out.elapsed().as_secs_f64() * 1e3;
+        st.last_pose = pose.start;
+        if taken {
+            if let Some(r) = st.recording.as_mut() {
+                r.raw.clear();
+            }
+            if let Some(j) = opts.pose.as_mut().and_then(|p| p.state.journal.as_mut()) {
+                j.clear();
+            }
+        }
+        *ingest = Duration::ZERO;
+        // Output errors end the run, so only this path needs the frame's time.
+        st.busy += t_frame.elapsed();
+        Ok(opts.frames.is_some_and(|n| summary.frames >= n))
+    }
+}
+
+/// Whether the loop has fallen more than a revolution behind the LiDAR: bytes queued on a
+/// port, or (simulated robot paced in real time) wall time ahead of the sensor clock.
+fn behind_lidar(
+    source: &LidarSource,
+    backlog_bytes: Option<u32>,
+    pacing: Pacing,
+    stream: &impl FrameStream,
+    start: &Instant,
+    period_s: f64,
+) -> bool {
+    if let Some(queued) = backlog_bytes {
+        return stream
+            .bytes_per_revolution()
+            .is_some_and(|per_rev| queued > per_rev);
+    }
+    source.is_simulated()
+        && pacing == Pacing::RealTime
+        && start.elapsed().as_secs_f64() - stream.sensor_time_s() > period_s
+}
+
+/// The pose halfway between two poses (heading along the shorter way round).
+fn midway(a: &Pose2, b: &Pose2) -> Pose2 {
+    Pose2::new(
+        (a.x + b.x) / 2.0,
+        (a.y + b.y) / 2.0,
+        perception::geometry::wrap_angle(
+            a.theta + perception::geometry::wrap_angle(b.theta - a.theta) / 2.0,
+        ),
+    )
+}

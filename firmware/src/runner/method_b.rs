@@ -1,0 +1,96 @@
+//! Method B as a stage of the frame: the last three revolutions encoded as the 64 × 384 × 3
+//! raster into the network's input, the network run, its boxes decoded and placed in the map
+//! from the middle revolution's pose (the pose the training labels used).
+//!
+//! The network is behind the [`Network`] trait so that the loop builds the same with and
+//! without tract (feature `method-b`: `models::yolo::YoloModel` implements it).
+
+use perception::fusion::PlacedBox;
+use perception::geometry::Pose2;
+use perception::raster::{RasterConfig, SCAN_COLUMNS, encode_chw_f32};
+use perception::yolo::{ANCHORS, DecodeConfig, DecodeScratch, Detection, MAX_DETECTIONS, decode};
+
+/// Method B's network: an input tensor to fill and a run that hands its output to a closure.
+pub trait Network {
+    /// The model's name, for messages.
+    fn name(&self) -> &str;
+    /// The `1 × 3 × 64 × 384` input floats.
+    fn input_mut(&mut self) -> &mut [f32];
+    /// Runs on the current input and calls `f` with the `8 × 504` output floats; the error is
+    /// a message naming the model.
+    fn run_with(&mut self, f: &mut dyn FnMut(&[f32])) -> Result<(), String>;
+}
+
+#[cfg(feature = "method-b")]
+impl Network for models::yolo::YoloModel {
+    fn name(&self) -> &str {
+        models::yolo::YoloModel::name(self)
+    }
+    fn input_mut(&mut self) -> &mut [f32] {
+        models::yolo::YoloModel::input_mut(self)
+    }
+    fn run_with(&mut self, f: &mut dyn FnMut(&[f32])) -> Result<(), String> {
+        self.run(f).map_err(|e| e.to_string())
+    }
+}
+
+/// Method B at run time: the loaded model and how to read its boxes.
+pub struct MethodBSetup {
+    /// The network, loaded and optimised at start-up.
+    pub model: Box<dyn Network>,
+    /// Raster settings (must match the training data's).
+    pub raster: RasterConfig,
+    /// Thresholds and suppression.
+    pub decode: DecodeConfig,
+    /// The LiDAR's pose on the robot.
+    pub mount: Pose2,
+}
+
+/// Method B's working memory, allocated once.
+pub struct MethodBScratch {
+    detections: heapless::Vec<Detection, MAX_DETECTIONS>,
+    decode: Box<DecodeScratch>,
+}
+
+impl Default for MethodBScratch {
+    fn default() -> Self {
+        MethodBScratch {
+            detections: heapless::Vec::new(),
+            decode: Box::new(DecodeScratch::new()),
+        }
+    }
+}
+
+impl MethodBSetup {
+    /// Runs on three revolutions (newest first) and calls `place` with each box in the map;
+    /// `middle` is the robot's pose at the middle of the previous revolution. `Err` carries
+    /// the message of a failed frame.
+    pub fn frame(
+        &mut self,
+        scans: [&[f32; SCAN_COLUMNS]; 3],
+        middle: Pose2,
+        scratch: &mut MethodBScratch,
+        mut place: impl FnMut(PlacedBox),
+    ) -> Result<(), String> {
+        encode_chw_f32(self.model.input_mut(), scans, &self.raster).map_err(|e| e.to_string())?;
+        let (dets, decode_scratch) = (&mut scratch.detections, &mut scratch.decode);
+        let cfg = &self.decode;
+        let mut decoded = None;
+        self.model.run_with(&mut |out| {
+            decoded = Some(decode(out, ANCHORS, cfg, decode_scratch, dets));
+        })?;
+        if let Some(Err(e)) = decoded {
+            return Err(e.to_string());
+        }
+        let lidar = middle.compose(&self.mount);
+        for d in scratch.detections.iter() {
+            place(PlacedBox {
+                class: d.class,
+                centre: d.centre(&lidar, &self.raster),
+                score: d.score,
+                bbox: [d.cx, d.cy, d.w, d.h],
+            });
+        }
+        Ok(())
+    }
+}
