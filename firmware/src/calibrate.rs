@@ -11,8 +11,7 @@ use std::path::Path;
 
 use perception::pose::{HardIron, HardIronFit};
 
-use crate::cli::CalibrateArgs;
-use crate::launch::{EXIT_FAULT, EXIT_USAGE, Failure};
+use crate::cli::{CalibrateArgs, EXIT_FAULT, EXIT_USAGE, Failure};
 use crate::odom::OdomRecord;
 use crate::reader::open_compass;
 

@@ -1,5 +1,5 @@
 //! CARMEN logs (`*.clf`, `*.log`, gzip-compressed or not) replayed through the frame loop
-//! (`interfaces.md` §2), for testing against real laser data (`../shared/data/README.md` §1).
+//! (`docs/interfaces.md` §2), for testing against real laser data (`../shared/data/README.md` §1).
 //!
 //! A [`CarmenStream`] is a [`FrameStream`] over the log's text:
 //! * each `FLASER` line is one frame: its n beams, evenly spaced over 180° from −90° (right)

@@ -5,6 +5,14 @@ use std::path::PathBuf;
 use clap::{Args, Parser, Subcommand, ValueEnum};
 use drivers::lidar::LidarModel;
 
+/// Exit status for bad arguments or configuration.
+pub const EXIT_USAGE: u8 = 2;
+/// Exit status for an unrecoverable runtime fault.
+pub const EXIT_FAULT: u8 = 1;
+
+/// A command's failure: the exit status and the message.
+pub type Failure = (u8, String);
+
 /// umbra: camera-free perception for small indoor robots.
 #[derive(Debug, Parser)]
 #[command(name = "umbra", version, about)]

@@ -1,5 +1,5 @@
 //! Deadlines: per-stage timing histograms, the stage budgets, the overrun policy, and the
-//! deadline table of `interfaces.md` §4.
+//! deadline table of `docs/interfaces.md` §4.
 //!
 //! Every stage of every frame is timed with the monotonic clock into a fixed-bucket histogram
 //! ([`Histogram`]: log-spaced, 40 buckets a decade from 1 µs to 10 s, so a percentile is
@@ -328,7 +328,7 @@ pub struct PowerVerdict {
     pub source: String,
 }
 
-/// The deadline and power table of `interfaces.md` §4 (Markdown, so CI logs and notes can
+/// The deadline and power table of `docs/interfaces.md` §4 (Markdown, so CI logs and notes can
 /// carry it as is).
 pub fn table(r: &DeadlineRecord, budgets: &Budgets, power: &PowerVerdict) -> String {
     let mut s = String::new();

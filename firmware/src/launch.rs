@@ -13,6 +13,7 @@ use drivers::opencr::OpencrReader;
 use models::yolo::{YoloModel, YoloOptions};
 
 use crate::cli::{Common, ReplayArgs, RunArgs, Speed};
+pub use crate::cli::{EXIT_FAULT, EXIT_USAGE, Failure};
 use crate::config::Config;
 use crate::odom::{OdomFile, PoseInput, PoseState};
 use crate::power::PowerMeter;
@@ -20,14 +21,6 @@ use crate::reader::open_compass;
 use crate::runner::{self, MethodBSetup, RunOptions, SecondsClock, Summary};
 use crate::sink::{FrameSink, JsonlSink, StatsSink};
 use crate::source::{LidarSource, Pacing};
-
-/// Exit status for bad arguments or configuration.
-pub const EXIT_USAGE: u8 = 2;
-/// Exit status for an unrecoverable runtime fault.
-pub const EXIT_FAULT: u8 = 1;
-
-/// A command's failure: the exit status and the message.
-pub type Failure = (u8, String);
 
 /// `umbra run`: a LiDAR port, or the built-in simulated robot when none is named.
 pub fn run(args: RunArgs) -> Result<(), Failure> {
@@ -371,15 +364,10 @@ fn run_loop(
         }
         None => {
             let window = cfg.lidar();
-            let o = &cfg.odometry;
             let stream = crate::carmen::CarmenStream::new(
                 window.min_range_m.unwrap_or(0.12),
                 window.max_range_m.unwrap_or(3.5),
-                perception::pose::OdometryConfig {
-                    wheel_radius_m: o.wheel_radius_m,
-                    wheel_separation_m: o.wheel_separation_m,
-                    ticks_per_rev: o.ticks_per_rev,
-                },
+                cfg.odometry(),
             );
             runner::run(source, stream, opts)
         }
@@ -405,9 +393,12 @@ fn start_viz(common: &Common, source: &LidarSource) -> Result<Option<Box<dyn Fra
         meta: source.recording_meta(),
     };
     let link = crate::viz::VizLink::start(&targets).map_err(|m| (EXIT_USAGE, m))?;
-    if let Some(port) = link.live_port() {
-        log::info!(
-            "live view: Foxglove WebSocket on port {port} (open ws://<this host>:{port} in Foxglove)"
+    if let (Some(port), Some(addr)) = (link.live_port(), common.live) {
+        // Always said (not only in the log): with `--live HOST:0` this is how a client learns
+        // the port the server bound.
+        eprintln!(
+            "umbra: live view on ws://{}:{port} (Foxglove: Open connection; from another machine use this host's address)",
+            addr.ip()
         );
     }
     if let Some(p) = &common.record {

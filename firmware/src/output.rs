@@ -1,4 +1,4 @@
-//! The per-frame output: the JSON line of `interfaces.md` §3 and the human-readable
+//! The per-frame output: the JSON line of `docs/interfaces.md` §3 and the human-readable
 //! per-revolution statistics line.
 
 use std::io::{self, Write};
@@ -125,7 +125,7 @@ impl From<crate::deadline::FrameTimes> for TimingOut {
     }
 }
 
-/// Cumulative fault counters (`interfaces.md` names first, extra keys after).
+/// Cumulative fault counters (`docs/interfaces.md` names first, extra keys after).
 #[derive(Debug, Clone, Copy, Serialize, Default, PartialEq, Eq)]
 pub struct FaultsOut {
     /// Bytes not part of any packet passed on.
@@ -229,7 +229,7 @@ pub struct LidarOut {
     pub queue_chunks_max: Option<usize>,
 }
 
-/// One output line (`interfaces.md` §3).
+/// One output line (`docs/interfaces.md` §3).
 #[derive(Debug, Clone, Serialize, PartialEq)]
 pub struct OutputLine<'a> {
     /// Frame number since start.

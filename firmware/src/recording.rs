@@ -1,4 +1,4 @@
-//! Replay of umbra's own MCAP recordings (`interfaces.md` §2): `umbra replay RUN.mcap` reads
+//! Replay of umbra's own MCAP recordings (`docs/interfaces.md` §2): `umbra replay RUN.mcap` reads
 //! back what `--record` wrote for it ([`crate::viz`], channels in [`crate::record_format`]): the LiDAR's bytes exactly as read
 //! (`/umbra/lidar_raw`) and every encoder/compass sample the pose filter was fed
 //! (`/umbra/odometry`, each with the frame at which it became available), then runs them

@@ -13,7 +13,7 @@
 //!   bytes exactly as read (message encoding `application/octet-stream`, no schema; channel
 //!   metadata names the model and, for the simulated robot, its compass calibration), and
 //!   `/umbra/odometry`, every encoder/compass sample as the `--odom` JSON object of
-//!   `interfaces.md` §2 plus the frame at which it became available to the pose (encoding
+//!   `docs/interfaces.md` §2 plus the frame at which it became available to the pose (encoding
 //!   `json`, a JSON Schema).
 //!
 //! The frame loop never allocates for this: it fills a [`VizFrame`] taken from a pool of

@@ -1,5 +1,5 @@
-//! End-to-end tests of the `umbra` binary: the contract of `interfaces.md` (commands, exit
-//! status, the first line, the JSON output line checked against `output-line.schema.json`).
+//! End-to-end tests of the `umbra` binary: the contract of `docs/interfaces.md` (commands, exit
+//! status, the first line, the JSON output line checked against `docs/output-line.schema.json`).
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
@@ -31,17 +31,23 @@ fn capture(path: &Path, revolutions: usize, mix: Corruption) {
     std::fs::write(path, bytes).unwrap();
 }
 
-/// The contract's JSON Schema, when `../shared/reference` is beside the repository.
-fn schema() -> Option<Value> {
-    let p = Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../../shared/reference/output-line.schema.json");
-    match std::fs::read_to_string(&p) {
-        Ok(s) => Some(serde_json::from_str(&s).expect("schema is JSON")),
-        Err(_) => {
-            println!("skipping schema check: {} not found", p.display());
-            None
-        }
+/// The output line's JSON Schemas: the repository's own (`docs/output-line.schema.json`,
+/// always), and the product owner's contract when `../shared/reference` is beside the
+/// repository (the two must agree: a line valid for ours is valid for theirs).
+fn schemas() -> Vec<Value> {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let ours = root.join("../docs/output-line.schema.json");
+    let text = std::fs::read_to_string(&ours).unwrap_or_else(|e| panic!("{}: {e}", ours.display()));
+    let mut v = vec![serde_json::from_str(&text).expect("docs/output-line.schema.json is JSON")];
+    let theirs = root.join("../../shared/reference/output-line.schema.json");
+    match std::fs::read_to_string(&theirs) {
+        Ok(s) => v.push(serde_json::from_str(&s).expect("the contract's schema is JSON")),
+        Err(_) => println!(
+            "contract schema {} not found: checking against docs/output-line.schema.json only",
+            theirs.display()
+        ),
     }
+    v
 }
 
 /// A validator for the JSON Schema keywords the contract uses: type, required, properties,
@@ -182,7 +188,7 @@ fn replay_of_a_noisy_capture_writes_valid_lines_with_faults() {
         .map(|l| serde_json::from_str(l).unwrap())
         .collect();
     assert!(lines.len() >= 39, "{} frames", lines.len());
-    if let Some(schema) = schema() {
+    for schema in schemas() {
         for l in &lines {
             validate(l, &schema, "$").unwrap();
         }
@@ -523,7 +529,7 @@ fn calibrate_compass_writes_the_config_that_run_uses() {
 #[test]
 fn replay_of_a_simulated_recording_finds_its_true_objects() {
     // Both methods end to end: capture + odometry through `umbra replay`, objects scored
-    // against the recording's truth (same class within 0.3 m, `interfaces.md` §3). Method A's
+    // against the recording's truth (same class within 0.3 m, `docs/interfaces.md` §3). Method A's
     // objects are those with source A or AB, Method B's those with B or AB.
     let dir = recordings("method-a-ds", 4, 60, 11);
     let (mut with_walls, mut frames_seen) = (0, 0);
@@ -616,11 +622,11 @@ fn run_ends_with_the_deadline_table_and_report_rebuilds_it() {
     // Every line carries the figures the table is made of, and validates.
     let lines = json_lines(&jsonl);
     assert_eq!(lines.len(), 120);
-    let s = schema();
+    let s = schemas();
     for l in &lines {
         assert!(l["timing_ms"]["output"].is_number(), "{l}");
         assert!(l["power_source"].is_string(), "{l}");
-        if let Some(s) = &s {
+        for s in &s {
             validate(l, s, "line").unwrap();
         }
     }

@@ -327,7 +327,7 @@ fn sigterm_stops_the_motor_flushes_the_lines_and_prints_the_report() {
                 expect_byte(&mut master, b'b', Duration::from_secs(10), &mut heard),
                 "no motor-start byte"
             );
-            player.play(&mut master, 100, &done, &mut log);
+            player.play(&mut master, 300, &done, &mut log);
             saw_stop_byte(master, &heard)
         })
     };
@@ -338,8 +338,16 @@ fn sigterm_stops_the_motor_flushes_the_lines_and_prints_the_report() {
         .args(["--lidar-model", "lds01"])
         .spawn()
         .expect("umbra runs");
-    // Two seconds of frames (~10 revolutions), then the service manager's stop.
-    thread::sleep(Duration::from_secs(2));
+    // Frames flowing (at least five whole lines on disk, however slowly this machine started
+    // umbra), then the service manager's stop.
+    let deadline = Instant::now() + Duration::from_secs(60);
+    while std::fs::read_to_string(&jsonl).map_or(0, |t| t.matches('\n').count()) < 5 {
+        assert!(
+            Instant::now() < deadline,
+            "no frames from umbra within 60 s"
+        );
+        thread::sleep(Duration::from_millis(50));
+    }
     let killed = Command::new("kill")
         .args(["-TERM", &child.id().to_string()])
         .status()

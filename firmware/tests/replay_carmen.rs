@@ -1,4 +1,4 @@
-//! CARMEN logs through the whole runtime (`interfaces.md` §2: "CARMEN logs replay too, for
+//! CARMEN logs through the whole runtime (`docs/interfaces.md` §2: "CARMEN logs replay too, for
 //! testing against real laser data"): `umbra replay` on the real Intel Research Lab and
 //! Freiburg 079 logs of `../shared/data/carmen` (gzip-compressed, as stored). Every scan is a
 //! frame; the pose at each frame is the log's own pose of that scan (relative to the first),

@@ -1,4 +1,4 @@
-//! Replay of umbra's own MCAP recordings (`interfaces.md` §2), end to end through the binary:
+//! Replay of umbra's own MCAP recordings (`docs/interfaces.md` §2), end to end through the binary:
 //! a run on the simulated robot recorded with `--record`, replayed with `umbra replay RUN.mcap`,
 //! gives the same frames (time, pose, objects of both methods, walls, doors) as the run did;
 //! and files that are not such recordings are clear exit-2 errors.

@@ -82,20 +82,32 @@ fn record_writes_an_mcap_that_reads_back_and_a_snapshot() {
 
 #[test]
 fn a_live_client_sees_the_channels_and_receives_frames() {
-    let port = std::net::TcpListener::bind("127.0.0.1:0")
-        .unwrap()
-        .local_addr()
-        .unwrap()
-        .port();
+    // The server binds port 0 and says which port it got: no port is chosen here and then
+    // raced for, and the client retries its handshake until the server answers (or 30 s).
     let mut child = Command::new(env!("CARGO_BIN_EXE_umbra"))
-        .args(["run", "--frames", "40", "--quiet", "--live"])
-        .arg(format!("127.0.0.1:{port}"))
+        .args(["run", "--frames", "40", "--quiet", "--live", "127.0.0.1:0"])
         .env("RUST_LOG", "warn")
         .stdout(Stdio::null())
         .stderr(Stdio::piped())
         .spawn()
         .unwrap();
-    // Connect once the server listens.
+    let (tx, rx) = std::sync::mpsc::channel();
+    let stderr = child.stderr.take().unwrap();
+    std::thread::spawn(move || {
+        use std::io::BufRead as _;
+        for line in std::io::BufReader::new(stderr)
+            .lines()
+            .map_while(Result::ok)
+        {
+            if let Some(rest) = line.strip_prefix("umbra: live view on ws://127.0.0.1:") {
+                let port: u16 = rest.split_whitespace().next().unwrap().parse().unwrap();
+                let _ = tx.send(port);
+            }
+        }
+    });
+    let port = rx
+        .recv_timeout(Duration::from_secs(60))
+        .expect("umbra says the port its live server bound");
     let start = Instant::now();
     let mut ws = loop {
         let mut req = tungstenite::client::IntoClientRequest::into_client_request(format!(
@@ -104,11 +116,14 @@ fn a_live_client_sees_the_channels_and_receives_frames() {
         .unwrap();
         req.headers_mut()
             .insert("Sec-WebSocket-Protocol", "foxglove.sdk.v1".parse().unwrap());
-        match std::net::TcpStream::connect(("127.0.0.1", port)) {
-            Ok(tcp) => {
+        let attempt = std::net::TcpStream::connect(("127.0.0.1", port))
+            .map_err(|e| e.to_string())
+            .and_then(|tcp| {
                 tcp.set_read_timeout(Some(Duration::from_secs(10))).unwrap();
-                break tungstenite::client(req, tcp).expect("handshake").0;
-            }
+                tungstenite::client(req, tcp).map_err(|e| format!("handshake: {e}"))
+            });
+        match attempt {
+            Ok((ws, _)) => break ws,
             Err(_) if start.elapsed() < Duration::from_secs(30) => {
                 std::thread::sleep(Duration::from_millis(50))
             }

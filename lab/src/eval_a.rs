@@ -2,7 +2,7 @@
 //! held-out score (per-class precision / recall / F1, confusion matrix, clutter, door frames,
 //! merge errors).
 //!
-//! **Matching** (`interfaces.md` §3): a detection matches the nearest true object of any class
+//! **Matching** (`docs/interfaces.md` §3): a detection matches the nearest true object of any class
 //! (furniture or clutter) within 0.3 m of its centre; each true object takes at most one
 //! detection (closest first); the rest are false positives. **Observable**: a true object
 //! counts for recall when at least `min_cluster_points` (20) cloud points lie on its footprint

@@ -1,5 +1,5 @@
 //! The object classes umbra recognises, with the names the output line uses
-//! (`interfaces.md` §3).
+//! (`docs/interfaces.md` §3).
 
 use core::fmt;
 

@@ -9,7 +9,7 @@
 //! images/{train,val,test}/sNNNN_fFFFF.png   Method B rasters (384×64 RGB, perception::raster)
 //! labels/{train,val,test}/sNNNN_fFFFF.txt   YOLO boxes (sim::labels)
 //! method_a/sNNNN.jsonl           line 1: the scene; then per frame: pose, ranges, hit codes
-//! recordings/sNNNN/capture.bin   raw LDS-01 bytes (interfaces.md §2)
+//! recordings/sNNNN/capture.bin   raw LDS-01 bytes (docs/interfaces.md §2)
 //! recordings/sNNNN/odom.jsonl    encoder ticks + magnetometer on the capture's clock
 //! recordings/sNNNN/truth.jsonl   per frame: pose and objects in the map frame
 //! pictures/sNNNN.png             a picture of the scene (first few scenarios)
@@ -19,7 +19,7 @@
 //! the study's oscillation in place (even indices) and waypoint tours (odd).
 //!
 //! The map frame of `truth.jsonl` is the robot's pose at the start (as in the output line of
-//! `interfaces.md` §3); `method_a` poses are in the map frame too.
+//! `docs/interfaces.md` §3); `method_a` poses are in the map frame too.
 
 use std::fs;
 use std::io::{BufWriter, Write};

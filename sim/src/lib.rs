@@ -7,8 +7,7 @@
 //!
 //! | module        | owns                                                                 |
 //! |---------------|----------------------------------------------------------------------|
-//! | [`world`]     | rooms (rectangle, L, two rooms + corridor), doors, furniture, clutter |
-//! | [`grid`]      | the spatial index and grid-walking ray caster                         |
+//! | [`world`]     | rooms (rectangle, L, two rooms + corridor), doors, furniture, clutter; its spatial index and ray caster (`world::grid`) |
 //! | [`robot`]     | differential drive (Burger constants), slip, encoders, motion scripts |
 //! | [`compass`]   | magnetometer: earth field, hard iron, noise, local disturbances       |
 //! | [`lds01`]     | LDS-01 reading model and the packet byte source                       |
@@ -26,7 +25,6 @@ pub mod compass;
 pub mod corrupt;
 #[cfg(feature = "tools")]
 pub mod dataset;
-pub mod grid;
 pub mod labels;
 pub mod lds01;
 pub mod noise;

@@ -5,7 +5,7 @@
 //! instants of every packet slot, and the ray leaves from the LiDAR's pose at that instant, so
 //! a turning robot's scan is skewed exactly as a real one. Encoder and compass samples come at
 //! [`ScenarioConfig::odom_hz`] on the same clock as the LiDAR (the sensor clock of
-//! `interfaces.md` §2: t = 0 at the start of the first packet).
+//! `docs/interfaces.md` §2: t = 0 at the start of the first packet).
 
 use drivers::lds01::{PACKETS_PER_REV, READINGS_PER_PACKET, READINGS_PER_REV, RawReading, Repr};
 use perception::geometry::{Point2, Pose2};

@@ -9,7 +9,7 @@
 //! whose bin it falls in, so every model sees the same ranges and the pipeline's objects can be
 //! compared across models. For the LDS-02 the inverse of the LD08 geometry correction is
 //! applied (raw distance and raw angle), so the driver's correction gives the scene back.
-//! Sensor clocks follow `interfaces.md` §2: LDROBOT frames carry millisecond stamps (wrapping
+//! Sensor clocks follow `docs/interfaces.md` §2: LDROBOT frames carry millisecond stamps (wrapping
 //! at 30000), RPLIDAR nodes carry nothing.
 
 use drivers::ldrobot::{self, FrameRepr, POINTS, RawPoint};

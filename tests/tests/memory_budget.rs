@@ -134,6 +134,11 @@ fn buffers_in_code() -> Vec<(&'static str, usize, usize)> {
             size_of::<MethodA>(),
         ),
         (
+            "perception::fusion::MAX_FRAME_OBJECTS",
+            perception::fusion::MAX_FRAME_OBJECTS,
+            size_of::<perception::fusion::FrameObject>(),
+        ),
+        (
             "firmware::runner::METHOD_B_HISTORY",
             METHOD_B_HISTORY,
             size_of::<[f32; perception::raster::SCAN_COLUMNS]>(),

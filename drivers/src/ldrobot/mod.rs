@@ -21,7 +21,7 @@
 //! 4. **Direction:** the raw angle runs clockwise; ours is `360° − θ` (+ the LD08 shift).
 //! 5. **Sweep:** a new revolution starts where the raw angle wraps (drops by more than 180°).
 //!
-//! ## Sensor clock (`interfaces.md` §2)
+//! ## Sensor clock (`docs/interfaces.md` §2)
 //!
 //! t = 0 at the first valid frame; each frame's millisecond timestamp (wrapping at 30000)
 //! advances the clock by its difference to the previous one (a stamp behind the previous one

@@ -15,7 +15,7 @@
 //! despite a failed checksum (`Count` policy) is used only if its index follows the previous
 //! packet's; otherwise its index cannot be trusted and it is dropped and counted.
 //!
-//! ## Sensor clock (`interfaces.md` §2)
+//! ## Sensor clock (`docs/interfaces.md` §2)
 //!
 //! t = 0 at the start of the first packet; each packet slot lasts `1/rpm` seconds with rpm from
 //! that packet's speed field (60 slots = `60/rpm` s, ~0.2 s at 300 rpm). A lost packet still

@@ -225,7 +225,7 @@ pub trait LidarStream {
     /// The link was lost and reopened: a partial frame cannot continue.
     fn link_reset(&mut self);
 
-    /// The sensor clock (`interfaces.md` §2) at the latest data, seconds.
+    /// The sensor clock (`docs/interfaces.md` §2) at the latest data, seconds.
     fn sensor_time_s(&self) -> f64;
 
     /// All fault counters.

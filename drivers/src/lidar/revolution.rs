@@ -29,7 +29,7 @@
 //!
 //! ## Time stamps
 //!
-//! [`Revolution::t_start_s`] is on the sensor's own clock (`interfaces.md` §2): the start of
+//! [`Revolution::t_start_s`] is on the sensor's own clock (`docs/interfaces.md` §2): the start of
 //! the sweep (for the LDS-01, the start of packet slot 0). The bin swept `f` of the way round
 //! was taken at `t_start_s + f · period_s` ([`Revolution::reading_time_s`]), so a moving robot's
 //! scan can be de-skewed; the frame's stamp is the first ray's time

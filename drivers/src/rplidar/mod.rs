@@ -14,7 +14,7 @@
 //! when that node was lost; either only once at least 270° have been swept since the last
 //! start, so a lost or repeated flag cannot cut a revolution into pieces.
 //!
-//! ## Sensor clock (`interfaces.md` §2)
+//! ## Sensor clock (`docs/interfaces.md` §2)
 //!
 //! Nodes carry no time: t = 0 at the first node and each node advances t by one sample period
 //! of the model (A1 2 kHz, A2 4 kHz in SCAN mode).

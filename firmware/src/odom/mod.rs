@@ -1,4 +1,4 @@
-//! Odometry and compass input for the pose: the `--odom` JSON Lines of `interfaces.md` §2
+//! Odometry and compass input for the pose: the `--odom` JSON Lines of `docs/interfaces.md` §2
 //! (`{"t": …, "left_ticks": …, "right_ticks": …}` and/or `{"t": …, "mag_ut": [x, y, z]}`), read
 //! in step with the LiDAR frames on the same clock, or samples handed over by the simulated
 //! robot. Both feed one [`PoseFilter`].

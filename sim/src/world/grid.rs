@@ -6,7 +6,7 @@
 
 use perception::geometry::Point2;
 
-use crate::world::Prim;
+use super::Prim;
 
 /// Cell size, metres.
 pub const CELL: f32 = 0.25;
