@@ -5,7 +5,7 @@
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use drivers::lds01::{Lds01Config, Lds01Stream};
-use drivers::lidar::LidarStream as _;
+use drivers::lidar::RevolutionStream as _;
 use sim::corrupt::Corruption;
 use std::hint::black_box;
 

@@ -9,7 +9,7 @@
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use drivers::ldrobot::frame::{FRAME_LEN, FrameRepr, crc8};
-use drivers::lidar::{AnyLidar, LidarConfig, LidarModel, LidarStream};
+use drivers::lidar::{AnyLidar, LidarConfig, LidarModel, RevolutionStream};
 use drivers::rplidar::protocol::{NODE_LEN, Node, sync_ok};
 use sim::corrupt::{Corruption, corrupt};
 use sim::scenario::{Scenario, ScenarioConfig};

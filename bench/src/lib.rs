@@ -95,7 +95,7 @@ pub fn median_ms(f: &mut dyn FnMut()) -> f64 {
 mod test {
     use super::*;
     use drivers::lds01::{Lds01Config, Lds01Stream};
-    use drivers::lidar::LidarStream as _;
+    use drivers::lidar::RevolutionStream as _;
 
     #[test]
     fn peer_port_agrees_with_ours_on_clean_bytes() {

@@ -32,34 +32,15 @@ pub const MAX_PACKET_LEN: usize = 64;
 /// Most data bytes a decoded status carries.
 pub const MAX_STATUS_DATA: usize = MAX_PACKET_LEN - 11;
 
-const fn crc_table() -> [u16; 256] {
-    let mut t = [0u16; 256];
-    let mut i = 0;
-    while i < 256 {
-        let mut c = (i as u16) << 8;
-        let mut b = 0;
-        while b < 8 {
-            c = if c & 0x8000 != 0 {
-                (c << 1) ^ 0x8005
-            } else {
-                c << 1
-            };
-            b += 1;
-        }
-        t[i] = c;
-        i += 1;
-    }
-    t
-}
-
-static CRC_TABLE: [u16; 256] = crc_table();
+/// ROBOTIS's CRC-16 is CRC-16/UMTS (a.k.a. BUYPASS: polynomial 0x8005, init 0, no
+/// reflection, no final xor; check 0xFEE8), table-driven by the `crc` crate.
+const CRC16: crc::Crc<u16> = crc::Crc::<u16>::new(&crc::CRC_16_UMTS);
 
 /// CRC-16 of `bytes` as ROBOTIS specifies it (continuing from `crc`; start with 0).
-pub fn crc16(mut crc: u16, bytes: &[u8]) -> u16 {
-    for &b in bytes {
-        crc = (crc << 8) ^ CRC_TABLE[usize::from(((crc >> 8) as u8) ^ b)];
-    }
-    crc
+pub fn crc16(crc: u16, bytes: &[u8]) -> u16 {
+    let mut d = CRC16.digest_with_initial(crc);
+    d.update(bytes);
+    d.finalize()
 }
 
 /// Codec errors.

@@ -7,7 +7,7 @@
 //!
 //! | module      | owns                                                          | needs  |
 //! |-------------|---------------------------------------------------------------|--------|
-//! | [`lidar`]   | the revolution every model yields, the `LidarStream` trait, auto-detection | core |
+//! | [`lidar`]   | the revolution every model yields, the `RevolutionStream` trait, auto-detection | core |
 //! | [`lds01`]   | LDS-01 packets, streaming decoder, revolution assembler        | core   |
 //! | [`ldrobot`] | LDS-02 (LD08), LD06, LD19: 47-byte CRC-8 frames → revolutions  | core   |
 //! | [`rplidar`] | RPLIDAR A1/A2: SCAN descriptor, 5-byte nodes, motor sequences  | core   |

@@ -4,7 +4,7 @@ use drivers::lds01::{
     ChecksumPolicy, Decoded, Decoder, Lds01Config, Lds01Stream, PACKET_LEN, Packet, RawReading,
     Repr,
 };
-use drivers::lidar::LidarStream as _;
+use drivers::lidar::RevolutionStream as _;
 use proptest::prelude::*;
 
 fn arb_repr() -> impl Strategy<Value = Repr> {

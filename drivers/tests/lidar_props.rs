@@ -2,7 +2,7 @@
 //! yields, over random frames, random streams and random chunkings.
 
 use drivers::ldrobot::{self, FRAME_LEN, FrameRepr, RawPoint};
-use drivers::lidar::{AnyLidar, LidarConfig, LidarModel, LidarStream};
+use drivers::lidar::{AnyLidar, LidarConfig, LidarModel, RevolutionStream};
 use drivers::rplidar::{self, NODE_LEN, Node};
 use proptest::prelude::*;
 

@@ -1,7 +1,7 @@
 //! CARMEN logs (`*.clf`, `*.log`, gzip-compressed or not) replayed through the frame loop
 //! (`docs/interfaces.md` §2), for testing against real laser data (`../shared/data/README.md` §1).
 //!
-//! A [`CarmenStream`] is a [`FrameStream`] over the log's text:
+//! A [`CarmenStream`] is a `drivers::lidar::RevolutionStream` over the log's text:
 //! * each `FLASER` line is one frame: its n beams, evenly spaced over 180° from −90° (right)
 //!   counter-clockwise (beam k at −90° + k·180°/n), binned into the 360 one-degree bins like
 //!   any LiDAR's points (closest valid return wins a bin; the pipeline's range window applies;
@@ -20,17 +20,13 @@
 //! * other messages (`PARAM`, `NEFF`, `SYNC`, comments) are skipped; a line that does not
 //!   parse, or is longer than [`LINE_CAPACITY`], is counted in `lidar_bytes_skipped`.
 
-use std::collections::VecDeque;
 use std::io::Read as _;
 use std::path::Path;
 
 use drivers::lidar::points::{Point, PointAssembler, PointConfig};
-use drivers::lidar::{LidarFaults, Revolution};
+use drivers::lidar::{LidarFaults, LidarModel, Revolution, RevolutionStream, WheelTicks};
 use perception::geometry::wrap_angle;
 use perception::pose::OdometryConfig;
-
-use crate::frames::FrameStream;
-use crate::odom::OdomRecord;
 
 /// The longest line kept (fr079's 360-beam scans are ~3 KB).
 pub const LINE_CAPACITY: usize = 16 * 1024;
@@ -114,7 +110,7 @@ pub struct CarmenStream {
     ranges: Vec<f32>,
     points: PointAssembler,
     odo: OdometryConfig,
-    pending: heapless::Deque<OdomRecord, ODOM_PENDING>,
+    pending: heapless::Deque<WheelTicks, ODOM_PENDING>,
     t0: Option<f64>,
     t_last_scan: f64,
     t_last: f64,
@@ -203,11 +199,10 @@ impl CarmenStream {
     fn emit_ticks(&mut self, t: f64) {
         let per_tick = 2.0 * std::f64::consts::PI * f64::from(self.odo.wheel_radius_m)
             / f64::from(self.odo.ticks_per_rev);
-        let r = OdomRecord {
+        let r = WheelTicks {
             t,
-            left_ticks: Some((self.wheels.0 / per_tick).round() as i64),
-            right_ticks: Some((self.wheels.1 / per_tick).round() as i64),
-            mag_ut: None,
+            left: (self.wheels.0 / per_tick).round() as i64,
+            right: (self.wheels.1 / per_tick).round() as i64,
         };
         if self.pending.push_back(r).is_err() {
             // Never: drained after every frame, at most three a scan.
@@ -298,7 +293,11 @@ impl CarmenStream {
     }
 }
 
-impl FrameStream for CarmenStream {
+impl RevolutionStream for CarmenStream {
+    fn model(&self) -> Option<LidarModel> {
+        None
+    }
+
     fn next_revolution(&mut self, input: &mut &[u8], _host_us: Option<u64>) -> bool {
         while let Some((&b, rest)) = input.split_first() {
             *input = rest;
@@ -361,10 +360,10 @@ impl FrameStream for CarmenStream {
         None
     }
 
-    fn drain_odometry(&mut self, out: &mut VecDeque<OdomRecord>) -> usize {
+    fn drain_odometry(&mut self, out: &mut dyn FnMut(WheelTicks)) -> usize {
         let mut n = 0;
         while let Some(r) = self.pending.pop_front() {
-            out.push_back(r);
+            out(r);
             n += 1;
         }
         n
@@ -432,10 +431,10 @@ mod tests {
         ]
         .concat();
         let mut input = text.as_bytes();
-        let mut q = VecDeque::new();
+        let mut q = std::collections::VecDeque::new();
         for _ in 0..3 {
             assert!(s.next_revolution(&mut input, None));
-            s.drain_odometry(&mut q);
+            s.drain_odometry(&mut |r| q.push_back(r));
         }
         // First scan: one sample; then turn–drive–turn a step (a pure turn: one).
         assert_eq!(q.len(), 1 + 3 + 1, "ODOM lines not used");
@@ -447,11 +446,7 @@ mod tests {
         );
         let mut last = 0.0;
         for r in &q {
-            f.encoders(
-                r.left_ticks.unwrap() as i32,
-                r.right_ticks.unwrap() as i32,
-                (r.t - last) as f32,
-            );
+            f.encoders(r.left as i32, r.right as i32, (r.t - last) as f32);
             last = r.t;
         }
         let p = f.pose();

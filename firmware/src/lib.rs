@@ -10,7 +10,6 @@
 //! | [`calibrate`]   | `umbra calibrate-compass`: readings, hard-iron fit, coverage, config write |
 //! | [`source`]      | LiDAR byte sources: serial port, capture, recording, CARMEN log, simulated robot |
 //! | [`reader`]      | reader threads: the LiDAR port's pooled chunks, the OpenCR/compass device thread, clock mapping |
-//! | [`frames`]      | the revolution stream the loop reads (every LiDAR's decoder, the log reader) |
 //! | [`carmen`]      | CARMEN logs as a revolution stream with their odometry               |
 //! | [`odom`]        | odometry/compass samples (`--odom`, devices, simulator, recordings) → pose |
 //! | [`runner`]      | the frame loop: ingest → pose → Method A → Method B → fusion → outputs |
@@ -35,7 +34,6 @@ pub mod carmen;
 pub mod cli;
 pub mod config;
 pub mod deadline;
-pub mod frames;
 pub mod launch;
 pub mod link_watch;
 pub mod odom;

@@ -3,8 +3,8 @@
 
 use std::time::Instant;
 
-use crate::frames::FrameStream;
 use crate::source::LidarSource;
+use drivers::lidar::RevolutionStream;
 
 /// Seconds without a byte from a live LiDAR before the loop says so.
 pub const SILENT_WARN_S: f64 = 2.0;
@@ -30,7 +30,7 @@ impl LinkWatch {
     }
 
     /// No bytes this time.
-    pub fn idle(&mut self, source: &LidarSource, stream: &impl FrameStream) {
+    pub fn idle(&mut self, source: &LidarSource, stream: &impl RevolutionStream) {
         let since = self.last_data.get_or_insert_with(Instant::now).elapsed();
         if !self.silent && !source.is_file() && since.as_secs_f64() > SILENT_WARN_S {
             log::warn!(
@@ -42,7 +42,7 @@ impl LinkWatch {
     }
 
     /// After bytes were fed: a stalled motor (LDS-01 speed field) starts or ends an episode.
-    pub fn after_feed(&mut self, stream: &impl FrameStream, frames: u64) {
+    pub fn after_feed(&mut self, stream: &impl RevolutionStream, frames: u64) {
         let stalled = stream.faults().stalled_packets;
         if stalled > self.stalled_seen {
             if !self.stalled {

@@ -323,13 +323,13 @@ impl LidarSource {
         }
     }
 
-    /// Moves encoder/compass samples the source produced into `out` (the simulator only).
+    /// Hands encoder/compass samples the source produced to `out` (the simulator only).
     #[cfg_attr(not(feature = "sim"), allow(unused_variables))]
-    pub fn drain_odometry(&mut self, out: &mut std::collections::VecDeque<OdomRecord>) {
+    pub fn drain_odometry(&mut self, out: &mut dyn FnMut(OdomRecord)) {
         #[cfg(feature = "sim")]
         if let LidarSource::Sim { sim, .. } = self {
             for o in sim.drain_odometry() {
-                out.push_back(OdomRecord {
+                out(OdomRecord {
                     t: o.t,
                     left_ticks: Some(i64::from(o.left_ticks)),
                     right_ticks: Some(i64::from(o.right_ticks)),

@@ -6,7 +6,7 @@
 
 use drivers::ldrobot::{FRAME_LEN, LdrobotConfig, LdrobotStream};
 use drivers::lidar::points::PointConfig;
-use drivers::lidar::{LidarModel, LidarStream};
+use drivers::lidar::{LidarModel, RevolutionStream};
 use libfuzzer_sys::fuzz_target;
 
 fuzz_target!(|data: &[u8]| {

@@ -7,7 +7,7 @@
 #![no_main]
 
 use drivers::lds01::{ChecksumPolicy, Lds01Config, Lds01Stream, PACKET_LEN};
-use drivers::lidar::LidarStream;
+use drivers::lidar::RevolutionStream;
 use libfuzzer_sys::fuzz_target;
 
 fuzz_target!(|data: &[u8]| {

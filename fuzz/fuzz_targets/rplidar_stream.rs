@@ -4,7 +4,7 @@
 #![no_main]
 
 use drivers::lidar::points::PointConfig;
-use drivers::lidar::{LidarModel, LidarStream};
+use drivers::lidar::{LidarModel, RevolutionStream};
 use drivers::rplidar::{RplidarConfig, RplidarStream};
 use libfuzzer_sys::fuzz_target;
 

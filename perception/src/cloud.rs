@@ -1,4 +1,5 @@
-//! The global point cloud of Method A: a fixed-capacity ring of map-frame points that every
+//! The global point cloud of Method A: a fixed-capacity ring (`heapless::Deque`) of map-frame
+//! points that every
 //! revolution feeds and ages.
 //!
 //! Each revolution first drops the oldest [`CloudConfig::drop_fraction`] of the points (5 % by
@@ -11,6 +12,8 @@
 //!
 //! Points that are not finite are refused and counted ([`GlobalCloud::rejected`]): NaN and
 //! infinite ranges must be filtered upstream, and this is the guard if they are not.
+
+use heapless::Deque;
 
 use crate::geometry::{Point2, Pose2};
 
@@ -57,13 +60,10 @@ pub struct Scan<'a> {
     pub mount: Pose2,
 }
 
-/// The cloud.
+/// The cloud: a `heapless::Deque` (the bound is in the type), oldest point at the front.
 #[derive(Clone)]
 pub struct GlobalCloud {
-    pts: [Point2; CLOUD_CAPACITY],
-    /// Index of the oldest point.
-    head: usize,
-    len: usize,
+    pts: Deque<Point2, CLOUD_CAPACITY>,
     overwritten: u64,
     rejected: u64,
 }
@@ -77,7 +77,7 @@ impl Default for GlobalCloud {
 impl core::fmt::Debug for GlobalCloud {
     fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
         f.debug_struct("GlobalCloud")
-            .field("len", &self.len)
+            .field("len", &self.pts.len())
             .field("overwritten", &self.overwritten)
             .field("rejected", &self.rejected)
             .finish()
@@ -88,9 +88,7 @@ impl GlobalCloud {
     /// An empty cloud.
     pub const fn new() -> Self {
         GlobalCloud {
-            pts: [Point2::new(0.0, 0.0); CLOUD_CAPACITY],
-            head: 0,
-            len: 0,
+            pts: Deque::new(),
             overwritten: 0,
             rejected: 0,
         }
@@ -98,12 +96,12 @@ impl GlobalCloud {
 
     /// Points held.
     pub fn len(&self) -> usize {
-        self.len
+        self.pts.len()
     }
 
     /// `true` when empty.
     pub fn is_empty(&self) -> bool {
-        self.len == 0
+        self.pts.is_empty()
     }
 
     /// Points overwritten because the ring was full.
@@ -118,8 +116,7 @@ impl GlobalCloud {
 
     /// Forgets every point (counters are kept).
     pub fn clear(&mut self) {
-        self.head = 0;
-        self.len = 0;
+        self.pts.clear();
     }
 
     /// Drops the oldest `floor(len · fraction)` points; returns how many went.
@@ -129,9 +126,11 @@ impl GlobalCloud {
         } else {
             0.0
         };
-        let n = ((self.len as f32 * f) as usize).min(self.len);
-        self.head = (self.head + n) % CLOUD_CAPACITY;
-        self.len -= n;
+        let len = self.pts.len();
+        let n = ((len as f32 * f) as usize).min(len);
+        for _ in 0..n {
+            self.pts.pop_front();
+        }
         n
     }
 
@@ -142,14 +141,12 @@ impl GlobalCloud {
             self.rejected += 1;
             return false;
         }
-        let tail = (self.head + self.len) % CLOUD_CAPACITY;
-        self.pts[tail] = p;
-        if self.len == CLOUD_CAPACITY {
-            self.head = (self.head + 1) % CLOUD_CAPACITY;
+        if self.pts.is_full() {
+            self.pts.pop_front();
             self.overwritten += 1;
-        } else {
-            self.len += 1;
         }
+        // Room was just made: the push cannot fail.
+        let _ = self.pts.push_back(p);
         true
     }
 
@@ -189,12 +186,7 @@ impl GlobalCloud {
 
     /// The points, oldest first, as two slices (the ring's two halves).
     pub fn as_slices(&self) -> (&[Point2], &[Point2]) {
-        let end = self.head + self.len;
-        if end <= CLOUD_CAPACITY {
-            (&self.pts[self.head..end], &[])
-        } else {
-            (&self.pts[self.head..], &self.pts[..end - CLOUD_CAPACITY])
-        }
+        self.pts.as_slices()
     }
 
     /// Every point, oldest first.

@@ -176,6 +176,8 @@ impl HardIronFit {
     }
 
     /// The fit, or `None` if the samples do not span a circle (too few, or no turning).
+    /// The 2 × 2 normal equations are solved by Cramer's rule with an explicit degeneracy
+    /// test relative to the spread: a closed form, in f64, that a matrix crate would not improve.
     pub fn solve(&self) -> Option<HardIron> {
         if self.n < 8.0 {
             return None;

@@ -103,7 +103,8 @@ fn box_at(parts: &[&[Point2]], origin: Point2, angle: f32) -> OrientedBox {
     }
 }
 
-/// The box along the principal axes of the points' covariance. O(n).
+/// The box along the principal axes of the points' covariance. O(n). The 2 × 2 covariance's
+/// axis is the closed form `atan2(2 sxy, sxx − syy) / 2` (no matrix library needed).
 pub fn principal_box(parts: &[&[Point2]]) -> OrientedBox {
     let c = centroid(parts);
     let (mut sxx, mut sxy, mut syy) = (0.0f32, 0.0f32, 0.0f32);

@@ -340,6 +340,9 @@ fn corner_between(a: &Segment, b: &Segment, cfg: &WallConfig, corners: &mut Corn
 }
 
 /// Weighted total-least-squares line through `v`, trimmed to the first and last vertex.
+///
+/// Hand-rolled on purpose: the 2 × 2 scatter's principal axis has a closed form (one `atan2`);
+/// nalgebra's iterative symmetric eigen-solver would add nothing but a dependency here.
 fn fit_line(v: &[Point2], w: &[u16]) -> Option<Segment> {
     let (mut sw, mut sx, mut sy) = (0.0f32, 0.0f32, 0.0f32);
     for (p, &k) in v.iter().zip(w) {

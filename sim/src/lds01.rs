@@ -228,7 +228,7 @@ mod test {
     use super::*;
     use crate::robot::{Motion, RobotConfig};
     use drivers::lds01::{Lds01Config, Lds01Stream};
-    use drivers::lidar::LidarStream as _;
+    use drivers::lidar::RevolutionStream as _;
     use perception::geometry::Point2;
 
     #[test]

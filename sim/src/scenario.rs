@@ -266,7 +266,7 @@ impl Scenario {
 mod test {
     use super::*;
     use drivers::lds01::{Lds01Config, Lds01Stream};
-    use drivers::lidar::LidarStream as _;
+    use drivers::lidar::RevolutionStream as _;
 
     #[test]
     fn frames_decode_through_the_real_driver() {

@@ -215,7 +215,7 @@ impl WireSim {
 mod test {
     use super::*;
     use crate::scenario::ScenarioConfig;
-    use drivers::lidar::{AnyLidar, LidarConfig, LidarStream};
+    use drivers::lidar::{AnyLidar, LidarConfig, RevolutionStream};
 
     /// Every model's bytes, decoded by its driver, give back the scene's ranges bin by bin.
     #[test]

@@ -5,7 +5,7 @@ use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
 use drivers::lds01::{Lds01Config, Lds01Stream};
-use drivers::lidar::LidarStream as _;
+use drivers::lidar::RevolutionStream as _;
 use sim::dataset::{DatasetConfig, FNV_OFFSET, fnv, generate, simulate};
 
 fn tmp(name: &str) -> PathBuf {

@@ -16,7 +16,7 @@ use std::thread;
 use std::time::{Duration, Instant};
 
 use drivers::lds01::{Lds01Config, Lds01Stream, PACKET_LEN};
-use drivers::lidar::LidarStream as _;
+use drivers::lidar::RevolutionStream as _;
 use drivers::serial::{LinkRead, SerialConfig, SerialLink};
 use serialport::TTYPort;
 use sim::lds01::{Lds01Sim, Lds01SimConfig};

@@ -41,34 +41,24 @@ pub const POINTS: usize = 12;
 /// The timestamp field wraps at this many milliseconds.
 pub const TIMESTAMP_WRAP_MS: u16 = 30_000;
 
-const POLY: u8 = 0x4D;
-
-/// The CRC-8 table (polynomial 0x4D, MSB first), built at compile time.
-pub const CRC_TABLE: [u8; 256] = {
-    let mut t = [0u8; 256];
-    let mut i = 0;
-    while i < 256 {
-        let mut c = i as u8;
-        let mut k = 0;
-        while k < 8 {
-            c = if c & 0x80 != 0 {
-                (c << 1) ^ POLY
-            } else {
-                c << 1
-            };
-            k += 1;
-        }
-        t[i] = c;
-        i += 1;
-    }
-    t
+/// The LDROBOT CRC-8: polynomial 0x4D, init 0, no reflection, no final xor (check 0xC3).
+pub const CRC8_LDROBOT: crc::Algorithm<u8> = crc::Algorithm {
+    width: 8,
+    poly: 0x4D,
+    init: 0x00,
+    refin: false,
+    refout: false,
+    xorout: 0x00,
+    check: 0xC3,
+    residue: 0x00,
 };
+
+/// Its 256-entry table, built at compile time by the `crc` crate.
+const CRC8: crc::Crc<u8> = crc::Crc::<u8>::new(&CRC8_LDROBOT);
 
 /// CRC-8 of `bytes` (init 0).
 pub fn crc8(bytes: &[u8]) -> u8 {
-    bytes
-        .iter()
-        .fold(0u8, |crc, &b| CRC_TABLE[usize::from(crc ^ b)])
+    CRC8.checksum(bytes)
 }
 
 /// The frame length that follows header byte 2 `info`, or `None` for an unknown type.
@@ -266,11 +256,10 @@ mod test {
     fn crc_check_value() {
         // lidars.md: CRC-8 poly 0x4D, init 0, no reflection, no xorout → 0xC3.
         assert_eq!(crc8(b"123456789"), 0xC3);
-        // Spot-check the generated table against the vendor table's first entries.
-        assert_eq!(
-            &CRC_TABLE[..8],
-            &[0x00, 0x4d, 0x9a, 0xd7, 0x79, 0x34, 0xe3, 0xae]
-        );
+        // Spot-check against the vendor table's first entries (one byte from init 0 is the
+        // table entry itself).
+        let first: [u8; 8] = core::array::from_fn(|i| crc8(&[i as u8]));
+        assert_eq!(first, [0x00, 0x4d, 0x9a, 0xd7, 0x79, 0x34, 0xe3, 0xae]);
     }
 
     /// A golden frame: bytes written out by hand from the field table, CRC computed

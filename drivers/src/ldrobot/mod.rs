@@ -35,7 +35,7 @@ pub use decoder::{Decoded, Decoder, DecoderStats};
 pub use frame::{FRAME_LEN, FrameRepr, HEADER, Health, POINTS, RawPoint};
 
 use crate::lidar::points::{Point, PointAssembler, PointConfig};
-use crate::lidar::{LidarFaults, LidarModel, LidarStream, Revolution};
+use crate::lidar::{LidarFaults, LidarModel, Revolution, RevolutionStream};
 
 /// LD08 geometry constants of the ROBOTIS driver (`transform.cpp`, `LD_EIGHT`).
 pub mod ld08 {
@@ -233,9 +233,9 @@ impl LdrobotStream {
     }
 }
 
-impl LidarStream for LdrobotStream {
-    fn model(&self) -> LidarModel {
-        self.model
+impl RevolutionStream for LdrobotStream {
+    fn model(&self) -> Option<LidarModel> {
+        Some(self.model)
     }
 
     fn next_revolution(&mut self, input: &mut &[u8], host_us: Option<u64>) -> bool {

@@ -7,7 +7,7 @@
 //! | [`packet`]    | the 42-byte packet: checked view, parsed form, checksum, `emit`  |
 //! | [`decoder`]   | bytes in any chunking → packets; resync; checksum policy; counters |
 //! | [`assembler`] | packets → revolutions; missing/repeated packets; sensor clock    |
-//! | this module   | [`Lds01Stream`], the two glued together, as a [`LidarStream`]   |
+//! | this module   | [`Lds01Stream`], the two glued together, as a [`RevolutionStream`]   |
 //!
 //! The revolution type is every model's ([`crate::lidar::revolution`]); an LDS-01 packet is
 //! one of its 6° sectors.
@@ -16,7 +16,7 @@
 //!
 //! ```
 //! use drivers::lds01::{Lds01Config, Lds01Stream, Repr, RawReading, PACKET_LEN};
-//! use drivers::lidar::LidarStream;
+//! use drivers::lidar::RevolutionStream;
 //!
 //! // Emit one revolution the way the simulator does, then decode it.
 //! let mut bytes = [0u8; 60 * PACKET_LEN];
@@ -44,7 +44,7 @@ pub mod revolution {
 }
 
 pub use crate::lidar::revolution::{Reading, Revolution, bin_angle_rad, raw_to_bin};
-use crate::lidar::{LidarFaults, LidarModel, LidarStream};
+use crate::lidar::{LidarFaults, LidarModel, RevolutionStream};
 pub use assembler::{Assembler, AssemblerConfig, AssemblerStats};
 pub use decoder::{ChecksumPolicy, Decoded, Decoder, DecoderStats};
 pub use packet::{
@@ -104,9 +104,9 @@ impl Lds01Stream {
     }
 }
 
-impl LidarStream for Lds01Stream {
-    fn model(&self) -> LidarModel {
-        LidarModel::Lds01
+impl RevolutionStream for Lds01Stream {
+    fn model(&self) -> Option<LidarModel> {
+        Some(LidarModel::Lds01)
     }
 
     fn next_revolution(&mut self, input: &mut &[u8], host_us: Option<u64>) -> bool {
@@ -159,7 +159,7 @@ impl LidarStream for Lds01Stream {
 
 /// Reads once from any `embedded_io::Read` into `buf` and feeds what came into `stream`.
 /// Returns the bytes read (0 = end of stream, after which the partial revolution is flushed).
-pub fn read_and_feed<R: embedded_io::Read, S: LidarStream>(
+pub fn read_and_feed<R: embedded_io::Read, S: RevolutionStream>(
     io: &mut R,
     buf: &mut [u8],
     stream: &mut S,

@@ -1,5 +1,5 @@
 //! What every LiDAR model shares: the [`Revolution`] the pipeline consumes, the
-//! [`LidarStream`] trait each model's byte decoder implements, the fault counters, the model
+//! [`RevolutionStream`] trait each model's byte decoder implements, the fault counters, the model
 //! list with its link facts, and [`AnyLidar`], one stream for whichever model was found.
 //!
 //! | module          | owns                                                              |
@@ -7,7 +7,7 @@
 //! | [`revolution`]  | 360 bins in REP 103 angles, sectors, time stamps (all models)     |
 //! | [`points`]      | native-angle points → revolutions: binning, sweep, staleness      |
 //! | [`detect`]      | which framing a byte stream speaks (auto-detection), with a diagnosis |
-//! | this module     | [`LidarModel`], [`LidarStream`], [`LidarFaults`], [`AnyLidar`]     |
+//! | this module     | [`LidarModel`], [`RevolutionStream`], [`LidarFaults`], [`AnyLidar`]     |
 //!
 //! A model's decoder turns bytes into revolutions of **360 bins, [0°, 360°), counter-clockwise,
 //! stamped at the first ray on the sensor's own clock**, whatever the sensor's native beam
@@ -201,15 +201,46 @@ pub struct LidarFaults {
     pub stalled_packets: u64,
 }
 
-/// A LiDAR byte decoder: bytes in any chunking → [`Revolution`]s. Every model implements it.
-/// Object-safe (the generic [`LidarStream::feed`] needs `Sized`), so [`AnyLidar`] forwards
-/// through `&dyn LidarStream`.
-pub trait LidarStream {
-    /// Which model this decodes.
-    fn model(&self) -> LidarModel;
+/// Wheel ticks that a stream carries besides its scans (a CARMEN log's poses, turned into the
+/// ticks of the configured drive), on the stream's clock.
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct WheelTicks {
+    /// Time, s, on the stream's clock.
+    pub t: f64,
+    /// Left wheel ticks, cumulative.
+    pub left: i64,
+    /// Right wheel ticks, cumulative.
+    pub right: i64,
+}
+
+/// A revolution stream: bytes in any chunking → [`Revolution`]s. Every LiDAR model's decoder
+/// implements it, and so does anything else that yields scans from bytes (the runtime's CARMEN
+/// log reader). Object-safe (the generic [`RevolutionStream::feed`] needs `Sized`), so
+/// [`AnyLidar`] forwards through `&dyn RevolutionStream`.
+pub trait RevolutionStream {
+    /// The LiDAR whose bytes this decodes; `None` for a stream that is not one LiDAR's bytes
+    /// (a log file).
+    fn model(&self) -> Option<LidarModel>;
+
+    /// Bytes of one revolution on the wire (the reader is behind when more wait); `None` when
+    /// the stream has no such rate.
+    fn bytes_per_revolution(&self) -> Option<u32> {
+        self.model().map(LidarModel::bytes_per_revolution)
+    }
+
+    /// What the stream decodes, for messages.
+    fn what(&self) -> &'static str {
+        self.model().map_or("scan log", LidarModel::display_name)
+    }
+
+    /// Hands wheel ticks decoded from the stream to `out` (logs only); returns how many.
+    fn drain_odometry(&mut self, _out: &mut dyn FnMut(WheelTicks)) -> usize {
+        0
+    }
 
     /// Consumes bytes from the front of `input` until a revolution is finished (returns
-    /// `true`; read it with [`LidarStream::last_revolution`]) or `input` is used up (`false`).
+    /// `true`; read it with [`RevolutionStream::last_revolution`]) or `input` is used up (`false`).
     /// `host_us` is the host's monotonic clock for these bytes, if any.
     fn next_revolution(&mut self, input: &mut &[u8], host_us: Option<u64>) -> bool;
 
@@ -335,7 +366,7 @@ impl AnyLidar {
         }
     }
 
-    fn inner(&self) -> &dyn LidarStream {
+    fn inner(&self) -> &dyn RevolutionStream {
         match self {
             AnyLidar::Lds01(s) => s,
             AnyLidar::Ldrobot(s) => s,
@@ -343,7 +374,7 @@ impl AnyLidar {
         }
     }
 
-    fn inner_mut(&mut self) -> &mut dyn LidarStream {
+    fn inner_mut(&mut self) -> &mut dyn RevolutionStream {
         match self {
             AnyLidar::Lds01(s) => s,
             AnyLidar::Ldrobot(s) => s,
@@ -352,8 +383,8 @@ impl AnyLidar {
     }
 }
 
-impl LidarStream for AnyLidar {
-    fn model(&self) -> LidarModel {
+impl RevolutionStream for AnyLidar {
+    fn model(&self) -> Option<LidarModel> {
         self.inner().model()
     }
     fn next_revolution(&mut self, input: &mut &[u8], host_us: Option<u64>) -> bool {

@@ -27,7 +27,7 @@ pub use decoder::{Decoded, Decoder, DecoderStats};
 pub use protocol::{Descriptor, NODE_LEN, Node, SCAN_DESCRIPTOR};
 
 use crate::lidar::points::{Point, PointAssembler, PointConfig};
-use crate::lidar::{LidarFaults, LidarModel, LidarStream, Revolution};
+use crate::lidar::{LidarFaults, LidarModel, Revolution, RevolutionStream};
 
 /// RPLIDAR stream settings.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -147,9 +147,9 @@ impl RplidarStream {
     }
 }
 
-impl LidarStream for RplidarStream {
-    fn model(&self) -> LidarModel {
-        self.model
+impl RevolutionStream for RplidarStream {
+    fn model(&self) -> Option<LidarModel> {
+        Some(self.model)
     }
 
     fn next_revolution(&mut self, input: &mut &[u8], host_us: Option<u64>) -> bool {

@@ -3,8 +3,9 @@
 //! the OpenCR and compass) queued until their frame, or a recording's samples made available
 //! at the frames they were in the recorded run. Every sample goes through one [`PoseState`].
 
-use std::collections::VecDeque;
 use std::time::Instant;
+
+use heapless::Deque;
 
 use perception::geometry::Pose2;
 
@@ -26,8 +27,9 @@ pub struct PoseInput {
     pub state: PoseState,
     /// An `--odom` file, read in step with the frames.
     pub file: Option<OdomFile>,
-    /// Samples from a live source (the simulator, the device thread), waiting for their frame.
-    pub queue: VecDeque<OdomRecord>,
+    /// Samples from a live source (the simulator, the device thread), waiting for their frame
+    /// (the bound is in the type; when full, the oldest is fed to the filter at once).
+    pub queue: Deque<OdomRecord, POSE_QUEUE>,
     /// The OpenCR and compass, polled by their own thread.
     pub devices: Option<DeviceReader>,
     /// Host time → LiDAR time, for the device thread's samples.
@@ -71,7 +73,7 @@ impl PoseInput {
         PoseInput {
             state,
             file: None,
-            queue: VecDeque::with_capacity(POSE_QUEUE),
+            queue: Deque::new(),
             devices: None,
             clock: ClockMap::default(),
             scheduled: Vec::new(),
@@ -115,24 +117,20 @@ impl PoseInput {
     /// Puts a sample in the queue (never growing it: when full, the oldest is fed at once)
     /// and notes it for the recording.
     fn enqueue(&mut self, r: OdomRecord) {
-        if self.queue.len() >= self.queue.capacity()
+        if self.queue.is_full()
             && let Some(old) = self.queue.pop_front()
         {
             self.state.feed(&old);
         }
         self.state.note_available(&r);
-        self.queue.push_back(r);
+        // Room was just made: the push cannot fail.
+        let _ = self.queue.push_back(r);
     }
 
-    /// Lets `drain` append samples to the queue (the simulator's, a log's) and notes each for
-    /// the recording.
-    pub fn take_from(&mut self, drain: impl FnOnce(&mut VecDeque<OdomRecord>)) {
-        let before = self.queue.len();
-        drain(&mut self.queue);
-        for k in before..self.queue.len() {
-            let r = self.queue[k];
-            self.state.note_available(&r);
-        }
+    /// Lets `drain` hand samples to the queue (the simulator's, a log's), each noted for the
+    /// recording.
+    pub fn take_from(&mut self, drain: impl FnOnce(&mut dyn FnMut(OdomRecord))) {
+        drain(&mut |r| self.enqueue(r));
     }
 
     /// Makes a recording's samples available at the frames they were in the recorded run.

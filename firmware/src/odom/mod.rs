@@ -35,6 +35,17 @@ pub struct OdomRecord {
     pub mag_ut: Option<[f32; 3]>,
 }
 
+impl From<drivers::lidar::WheelTicks> for OdomRecord {
+    fn from(w: drivers::lidar::WheelTicks) -> Self {
+        OdomRecord {
+            t: w.t,
+            left_ticks: Some(w.left),
+            right_ticks: Some(w.right),
+            mag_ut: None,
+        }
+    }
+}
+
 /// Samples the pose state's journal holds between two recorded frames.
 pub const JOURNAL_LEN: usize = 64;
 

@@ -15,7 +15,6 @@ use super::FrameLoop;
 use super::history::ScanHistory;
 use super::method_b::MethodBScratch;
 use crate::deadline::{DeadlineRecord, FrameTimes, Policy, SHRINK_DROP_FRACTION};
-use crate::frames::FrameStream;
 use crate::odom::{FramePose, PoseInput};
 use crate::output::{
     DoorOut, FaultsOut, LidarOut, ObjectOut, OutputLine, PoseOut, TimingOut, WallOut,
@@ -23,6 +22,7 @@ use crate::output::{
 use crate::record_format::RECORD_RAW_BYTES;
 use crate::sink::FrameView;
 use crate::source::{LidarSource, Pacing};
+use drivers::lidar::RevolutionStream;
 
 /// What the loop keeps between frames, allocated once at start-up.
 pub(super) struct FrameState {
@@ -180,7 +180,7 @@ impl FrameState {
     }
 }
 
-impl<S: FrameStream> FrameLoop<'_, S> {
+impl<S: RevolutionStream> FrameLoop<'_, S> {
     /// Hands the stream's last finished revolution out as one frame; `true` when the frame
     /// limit is reached.
     pub(super) fn emit_frame(&mut self) -> io::Result<bool> {
@@ -382,7 +382,7 @@ fn behind_lidar(
     source: &LidarSource,
     backlog_bytes: Option<u32>,
     pacing: Pacing,
-    stream: &impl FrameStream,
+    stream: &impl RevolutionStream,
     start: &Instant,
     period_s: f64,
 ) -> bool {

@@ -34,12 +34,12 @@ pub use method_b::{MethodBSetup, Network};
 pub use summary::Summary;
 
 use crate::deadline::{Budgets, PowerVerdict};
-use crate::frames::FrameStream;
 use crate::link_watch::LinkWatch;
-use crate::odom::PoseInput;
+use crate::odom::{OdomRecord, PoseInput};
 use crate::power::PowerMeter;
 use crate::sink::{FrameSink, RunEnd};
 use crate::source::{LidarSource, Pacing, SourceRead};
+use drivers::lidar::RevolutionStream;
 use frame::FrameState;
 
 /// Bytes read from the source at a time (~0.2 revolution; a capture is read in these too).
@@ -83,7 +83,7 @@ pub struct RunOptions {
 }
 
 /// Runs the loop until a limit, the end of the source, or the stop flag.
-pub fn run<S: FrameStream>(
+pub fn run<S: RevolutionStream>(
     source: &mut LidarSource,
     stream: S,
     opts: RunOptions,
@@ -119,7 +119,7 @@ struct FrameLoop<'s, S> {
     start: Instant,
 }
 
-impl<S: FrameStream> FrameLoop<'_, S> {
+impl<S: RevolutionStream> FrameLoop<'_, S> {
     /// Reads, decodes and hands out frames until a limit, the end or the stop flag; returns
     /// why it stopped.
     fn bytes_to_frames(&mut self) -> io::Result<&'static str> {
@@ -192,7 +192,7 @@ impl<S: FrameStream> FrameLoop<'_, S> {
                     // A log's odometry lines, up to the frame's scan.
                     let stream = &mut self.stream;
                     p.take_from(|q| {
-                        stream.drain_odometry(q);
+                        stream.drain_odometry(&mut |w| q(OdomRecord::from(w)));
                     });
                 }
                 if !done {

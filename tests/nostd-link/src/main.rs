@@ -8,7 +8,7 @@ use core::panic::PanicInfo;
 
 use drivers::lds01::{Lds01Config, Lds01Stream, PACKET_LEN, RawReading, Repr};
 use drivers::lidar::detect::Detector;
-use drivers::lidar::{AnyLidar, LidarConfig, LidarModel, LidarStream as _};
+use drivers::lidar::{AnyLidar, LidarConfig, LidarModel, RevolutionStream as _};
 use perception::geometry::{Point2, Pose2};
 
 /// Entry point: decode one emitted revolution and transform its points.
