@@ -1,6 +1,6 @@
 //! The LDROBOT and RPLIDAR streams' throughput, MB/s, on about 1 MB of each model's simulated
 //! bytes through the noisy line (1e-3 bit flips, inserted/dropped bytes, bursts), each against
-//! a peer in the same run written after the vendor's parsing rule (`lidars.md`): the LDROBOT
+//! a peer in the same run written after the vendor's parsing rule (`docs/hardware.md` §1): the LDROBOT
 //! SDK's byte state machine (collect 47 bytes, then check the CRC, restart at the next byte)
 //! and the RPLIDAR SDK's node loop (slide one byte on a failed bit test). The peers only frame
 //! and parse; ours also bin into revolutions, so the ratio is conservative.

@@ -1,7 +1,7 @@
 //! The OpenCR board of a TurtleBot3 as an encoder source: it answers DYNAMIXEL 2.0 READ
 //! requests for the wheels' present positions (i32 ticks, cumulative, wrapping) from its control
 //! table. Addresses and the device id are configuration ([`OpencrConfig`]), since firmware
-//! versions differ (`hardware.md`: id 200, left at 136, right at 140, 1 Mbps).
+//! versions differ (`docs/hardware.md`: id 200, left at 136, right at 140, 1 Mbps).
 //!
 //! [`OpencrReader::poll`] sends one READ covering both positions and waits for the status up to
 //! [`OpencrConfig::timeout`]; timeouts, bad answers and lost links are counted and returned as

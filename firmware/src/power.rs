@@ -4,9 +4,9 @@
 //! 1. an **INA219** supply-side monitor on I²C (`ina219` crate, embedded-hal 1.0): bus voltage
 //!    × shunt voltage / shunt resistance, read on its own thread every [`SAMPLE_PERIOD`];
 //! 2. the **Pi 5 PMIC** (`vcgencmd pmic_read_adc`): rail V·I summed, watts ≈ 1.1451 × Σ + 0.5879
-//!    (`hardware.md`), on its own thread every [`SAMPLE_PERIOD`];
+//!    (`docs/hardware.md`), on its own thread every [`SAMPLE_PERIOD`];
 //! 3. a **model** from this process's CPU time: idle + (full − idle) × load + the LiDAR, with the
-//!    board's measured idle and all-cores figures (`hardware.md`). On a host that is not a Pi the
+//!    board's measured idle and all-cores figures (`docs/hardware.md`). On a host that is not a Pi the
 //!    CPU time is scaled by how much slower the modelled board is ([`Board::slowdown`]).
 //!
 //! The frame loop only reads the latest figure ([`PowerMeter::watts`]): no allocation, no I/O
@@ -56,7 +56,7 @@ pub enum Board {
 }
 
 impl Board {
-    /// Idle and all-cores-stressed watts at the wall (`hardware.md`).
+    /// Idle and all-cores-stressed watts at the wall (`docs/hardware.md`).
     pub fn watts(self) -> (f64, f64) {
         match self {
             Board::Pi5 | Board::Auto => (2.8, 9.7),
@@ -66,7 +66,7 @@ impl Board {
     }
 
     /// How many times slower one core of the board is than a current desktop core
-    /// (`hardware.md`: Pi 5 ≈ 3.7×, a Pi 3 ≈ 13× slower than a Pi 5 on CNN work).
+    /// (`docs/hardware.md`: Pi 5 ≈ 3.7×, a Pi 3 ≈ 13× slower than a Pi 5 on CNN work).
     pub fn slowdown(self) -> f64 {
         match self {
             Board::Pi5 | Board::Auto => 3.7,

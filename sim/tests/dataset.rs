@@ -157,7 +157,7 @@ fn recordings_decode_through_the_driver_and_match_the_labels() {
 
 #[test]
 fn lidar_statistics_are_near_a_real_lds01() {
-    // Real TurtleBot3 recording (hardware.md): 14 % zeros overall, 4 % of returns beyond 3.5 m;
+    // Real TurtleBot3 recording (docs/hardware.md §1.0): 14 % zeros overall, 4 % of returns beyond 3.5 m;
     // the overall share depends on room size, so the dropout rate is checked where the spec
     // promises returns (≤ 3.5 m), and the far returns against the real share.
     let cfg = DatasetConfig {

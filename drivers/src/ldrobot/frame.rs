@@ -1,6 +1,6 @@
 //! The LDROBOT wire format (LDS-02 = LD08, LD06, LD19): the 47-byte measurement frame, the
 //! 4-byte health frame and the 27-byte information frame, all starting `0x54` and ending in a
-//! CRC-8 (`lidars.md` §1a–1b). Checked views that never panic, parsed forms, and `emit` for
+//! CRC-8 (`docs/hardware.md` §1a–1b). Checked views that never panic, parsed forms, and `emit` for
 //! the simulator and tests.
 //!
 //! Measurement frame, multi-byte fields little-endian:
@@ -254,7 +254,7 @@ mod test {
 
     #[test]
     fn crc_check_value() {
-        // lidars.md: CRC-8 poly 0x4D, init 0, no reflection, no xorout → 0xC3.
+        // docs/hardware.md §1a: CRC-8 poly 0x4D, init 0, no reflection, no xorout → 0xC3.
         assert_eq!(crc8(b"123456789"), 0xC3);
         // Spot-check against the vendor table's first entries (one byte from init 0 is the
         // table entry itself).

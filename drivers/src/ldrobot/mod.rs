@@ -1,5 +1,5 @@
 //! LDROBOT LiDARs: the ROBOTIS LDS-02 (= LD08, TurtleBot3 since 2022), LD06 and LD19. One wire
-//! format (`lidars.md` §1a–1b), three models that differ in baud rate, sample rate and, for the
+//! format (`docs/hardware.md` §1a–1b), three models that differ in baud rate, sample rate and, for the
 //! LD08, a geometry correction.
 //!
 //! | module      | owns                                                              |

@@ -27,7 +27,7 @@ use crate::framing::{Candidate, skip_to};
 pub const DECODER_BUFFER_LEN: usize = PACKET_LEN;
 
 /// What a checksum failure means. The LDS-01 checksum rule is unconfirmed on real hardware
-/// (see `hardware.md`), hence a setting.
+/// (see `docs/hardware.md`), hence a setting.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub enum ChecksumPolicy {

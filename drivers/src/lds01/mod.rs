@@ -52,7 +52,7 @@ pub use packet::{
     SYNC_BYTE,
 };
 
-/// Serial link settings of the LDS-01 (`hardware.md`).
+/// Serial link settings of the LDS-01 (`docs/hardware.md`).
 pub mod link {
     /// Baud rate, 8N1, no flow control.
     pub const BAUD: u32 = 230_400;

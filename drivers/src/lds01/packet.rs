@@ -1,7 +1,7 @@
 //! The LDS-01 42-byte packet: a checked view over bytes ([`Packet`]), the plain parsed form
 //! ([`Repr`]), the checksum, and `emit` into a caller buffer.
 //!
-//! Layout (little-endian), from `hardware.md`:
+//! Layout (little-endian), from `docs/hardware.md`:
 //!
 //! | bytes  | meaning                                                        |
 //! |--------|----------------------------------------------------------------|

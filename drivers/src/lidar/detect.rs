@@ -1,5 +1,5 @@
 //! Which LiDAR speaks in a byte stream: every family's decoder runs over the same bytes and
-//! the one that explains them wins (`--lidar-model auto`, `lidars.md` §1d.1–2).
+//! the one that explains them wins (`--lidar-model auto`, `docs/hardware.md` §1d.1–2).
 //!
 //! * **LDS-01:** `0xFA` + index `0xA0..=0xDB` + a good checksum.
 //! * **LDROBOT:** `0x54 0x2C` + a good CRC-8. The model follows from the frame itself: the

@@ -12,7 +12,7 @@
 //! A model's decoder turns bytes into revolutions of **360 bins, [0°, 360°), counter-clockwise,
 //! stamped at the first ray on the sensor's own clock**, whatever the sensor's native beam
 //! count, direction or time base: the three most common complaints against the vendors'
-//! drivers (changing beam counts, mirrored scans, publish-time stamps; `lidars.md` §1d) cannot
+//! drivers (changing beam counts, mirrored scans, publish-time stamps; `docs/hardware.md` §1d) cannot
 //! happen past this layer. Everything here is `no_std` and allocation-free.
 
 pub mod detect;

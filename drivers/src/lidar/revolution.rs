@@ -7,7 +7,7 @@
 //! (x forward, y left, seen from above). Bin `d` holds the reading closest to `d` degrees
 //! counter-clockwise, `d = 0..360`: [0°, 360°), no duplicate end, **the same count for every
 //! model and every revolution** whatever the sensor's native beam count (the complaint of
-//! `lidars.md` §1d.3 cannot happen). Every model we support sweeps **clockwise**; each family
+//! `docs/hardware.md` §1d.3 cannot happen). Every model we support sweeps **clockwise**; each family
 //! maps its raw angle into this convention once, in its own module:
 //!
 //! * LDS-01: raw reading `i = 6·k + j` (packet `k`, reading `j`) lies at `(359 − i)°`, the

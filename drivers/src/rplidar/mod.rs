@@ -1,4 +1,4 @@
-//! Slamtec RPLIDAR A1/A2 in standard SCAN mode (`lidars.md` §1c).
+//! Slamtec RPLIDAR A1/A2 in standard SCAN mode (`docs/hardware.md` §1c).
 //!
 //! | module        | owns                                                            |
 //! |---------------|-----------------------------------------------------------------|

@@ -1,5 +1,5 @@
 //! Starting and stopping an RPLIDAR: the motor line and the request order the SDK uses
-//! (`lidars.md` §1c, complaints §1d.7).
+//! (`docs/hardware.md` §1c, complaints §1d.7).
 //!
 //! * **A1, and A2 without the accessory board:** the Slamtec USB adapter switches the motor
 //!   with **DTR**: asserted = motor stopped, released = spinning. Opening a port often leaves

@@ -1,4 +1,4 @@
-//! The Slamtec RPLIDAR serial protocol, standard SCAN mode (`lidars.md` §1c): requests, the
+//! The Slamtec RPLIDAR serial protocol, standard SCAN mode (`docs/hardware.md` §1c): requests, the
 //! response descriptor, the 5-byte measurement node, the GET_INFO / GET_HEALTH payloads.
 //! Checked parsers that never panic and `emit` for the simulator and tests.
 //!

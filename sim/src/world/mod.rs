@@ -6,7 +6,7 @@
 //! the free outline, so a ray sees the inner face, and through a doorway the jamb faces and
 //! whatever lies beyond (a hallway wall for single rooms, the corridor and the other room).
 //!
-//! Furniture (`methods.md`, "World geometry"): a chair is four ~3 cm legs on a ~0.4 m square, a
+//! Furniture (the study's world geometry, `docs/simulator.md`): a chair is four ~3 cm legs on a ~0.4 m square, a
 //! desk four ~5 cm legs on ~0.8 × 1.6 m, a box a solid ~0.4 × 0.6 m rectangle, each scaled by
 //! U(0.8, 1.2), placed uniformly with random rotation, no overlaps and ≥ 0.7 m between
 //! footprints. Clutter: round bins, round pillars, and pairs of people's legs.
