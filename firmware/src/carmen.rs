@@ -265,15 +265,17 @@ impl CarmenStream {
                 self.odometry(t, x, y, th);
                 for (k, &r) in ranges.iter().enumerate() {
                     let range_m = if r >= NO_RETURN_M || r <= 0.0 { 0.0 } else { r };
+                    let angle_deg = -90.0 + k as f32 * 180.0 / n as f32;
                     let p = Point {
-                        angle_deg: -90.0 + k as f32 * 180.0 / n as f32,
+                        angle_deg,
+                        sweep_deg: angle_deg,
                         range_m,
                         intensity: 0,
                         t_s: t,
                     };
                     self.points.push(&p, k == 0, SCAN_PERIOD_S, None);
                 }
-                self.points.flush(SCAN_PERIOD_S);
+                self.points.hand_out(SCAN_PERIOD_S);
                 self.ranges = ranges;
                 self.stats.scans += 1;
                 Ok(true)

@@ -156,6 +156,9 @@ pub struct FaultsOut {
     pub lidar_sensor_errors: u64,
     /// LDS-01 packets whose speed field says the motor is stalled (below 60 rpm).
     pub lidar_stalled_packets: u64,
+    /// Partial revolutions not made into frames (LDROBOT, RPLIDAR): the lead-in before a
+    /// stream's first sweep start and an unfinished last one.
+    pub lidar_partial_revolutions_dropped: u64,
     /// Link losses (read errors, hang-ups).
     pub lidar_link_lost: u64,
     /// Link reopens.
@@ -201,6 +204,7 @@ impl FaultsOut {
             lidar_implausible_frames: f.implausible_frames,
             lidar_sensor_errors: f.sensor_errors,
             lidar_stalled_packets: f.stalled_packets,
+            lidar_partial_revolutions_dropped: f.partial_revolutions_dropped,
             lidar_link_lost: link.0,
             lidar_link_reopened: link.1,
             ..FaultsOut::default()

@@ -20,6 +20,7 @@
 //! | [`method_a`]   | the geometric pipeline end to end, classifier as a parameter |
 //! | [`yolo`]       | Method B's output: YOLOv8 decode, suppression, map-frame centres |
 //! | [`fusion`]     | one frame's objects from both methods: A's, and B's joined or added |
+//! | [`tracks`]     | the world model's tracks: stable ids, association, evidence, negative evidence |
 //!
 //! Each capacity is a named constant listed in
 //! `memory-budget.md`.
@@ -38,5 +39,6 @@ pub mod method_a;
 pub mod pose;
 pub mod raster;
 pub mod shape;
+pub mod tracks;
 pub mod walls;
 pub mod yolo;

@@ -134,6 +134,11 @@ fn buffers_in_code() -> Vec<(&'static str, usize, usize)> {
             size_of::<MethodA>(),
         ),
         (
+            "perception::tracks::MAX_TRACKS",
+            perception::tracks::MAX_TRACKS,
+            size_of::<perception::tracks::Track>(),
+        ),
+        (
             "perception::fusion::MAX_FRAME_OBJECTS",
             perception::fusion::MAX_FRAME_OBJECTS,
             size_of::<perception::fusion::FrameObject>(),

@@ -135,6 +135,7 @@ impl LdrobotStream {
             nominal_period_s: 0.2,
             pending: [Point {
                 angle_deg: 0.0,
+                sweep_deg: 0.0,
                 range_m: 0.0,
                 intensity: 0,
                 t_s: 0.0,
@@ -204,6 +205,7 @@ impl LdrobotStream {
             };
             self.pending[i] = Point {
                 angle_deg: 360.0 - raw + shift,
+                sweep_deg: 360.0 - raw,
                 range_m: d / 1000.0,
                 intensity: u16::from(p.confidence),
                 t_s: t_frame + i as f64 * dt,
@@ -303,6 +305,7 @@ impl RevolutionStream for LdrobotStream {
             bad_checksum: d.bad_crc,
             missing_packets: p.missing_sectors,
             incomplete_revolutions: p.incomplete_revolutions,
+            partial_revolutions_dropped: p.partial_dropped,
             implausible_frames: self.stats.implausible,
             sensor_errors: self.stats.health_errors,
             ..LidarFaults::default()

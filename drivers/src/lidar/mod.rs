@@ -199,6 +199,9 @@ pub struct LidarFaults {
     pub sensor_errors: u64,
     /// LDS-01: good packets whose speed field says the motor is stalled (below 60 rpm).
     pub stalled_packets: u64,
+    /// Point-based models (LDROBOT, RPLIDAR): partial revolutions not handed out as frames,
+    /// the lead-in before the stream's first sweep start and an unfinished last one.
+    pub partial_revolutions_dropped: u64,
 }
 
 /// Wheel ticks that a stream carries besides its scans (a CARMEN log's poses, turned into the

@@ -12,10 +12,13 @@
 //!   beams that fell in the bin returned;
 //! * stamps the revolution at its **first point's** sensor time and takes its period from the
 //!   next sweep's first point (or from the model's speed field when the sweep is cut short);
-//! * marks each 6° sector (sweep order) that got a point; sectors the sweep passed without
-//!   data are counted missing, as lost LDS-01 packets are;
-//! * hands out a partial revolution after a host-clock silence ([`PointAssembler::poll`]) or at
-//!   the end of the stream ([`PointAssembler::flush`]).
+//! * marks each 6° sector (sweep order, by the sweep's own angle before any geometry
+//!   correction) that got a point; sectors the sweep passed without data are counted missing,
+//!   as lost LDS-01 packets are;
+//! * hands out a partial revolution after a host-clock silence ([`PointAssembler::poll`]: a
+//!   live sensor that stalls), but not the lead-in before the stream's first sweep start nor an
+//!   unfinished revolution at the end of a stream ([`PointAssembler::flush`]): both are
+//!   dropped and counted ([`PointStats::partial_dropped`]), so no frame reports a made-up rpm.
 //!
 //! Storage: two [`Revolution`]s, swapped without copying, as in the LDS-01 assembler.
 
@@ -39,6 +42,11 @@ pub struct PointConfig {
 pub struct Point {
     /// Counter-clockwise angle from the LiDAR's forward axis, degrees, any value (wrapped).
     pub angle_deg: f32,
+    /// Where the sweep was when the point was measured (counter-clockwise degrees, before any
+    /// geometry correction of the model, e.g. the LDS-02's triangulation shift): the sector
+    /// accounting follows the sweep, so a corrected point moved across a sector boundary does
+    /// not leave its sector looking lost. Equal to `angle_deg` for models without correction.
+    pub sweep_deg: f32,
     /// Range in metres (0 = no return).
     pub range_m: f32,
     /// Return strength as sent.
@@ -59,6 +67,9 @@ pub struct PointStats {
     pub missing_sectors: u64,
     /// Points received.
     pub points: u64,
+    /// Partial revolutions not handed out: the lead-in before the first sweep start (the
+    /// stream began mid-sweep) and an unfinished last one at the end of the stream.
+    pub partial_dropped: u64,
 }
 
 /// The assembler; see the module docs.
@@ -68,6 +79,10 @@ pub struct PointAssembler {
     bufs: [Revolution; 2],
     filling: usize,
     in_progress: bool,
+    /// The revolution being filled began mid-sweep at the start of the stream (a lead-in).
+    lead_in: bool,
+    /// A revolution has been started since the stream began.
+    started: bool,
     /// Sensor time of the last point put in.
     t_last: f64,
     last_host_us: Option<u64>,
@@ -91,6 +106,8 @@ impl PointAssembler {
             bufs: [Revolution::empty(), Revolution::empty()],
             filling: 0,
             in_progress: false,
+            lead_in: false,
+            started: false,
             t_last: 0.0,
             last_host_us: None,
             next_seq: 0,
@@ -135,7 +152,13 @@ impl PointAssembler {
                 (Some(now), Some(last)) => now.saturating_sub(last) > self.cfg.stale_after_us,
                 _ => false,
             };
-            if new_sweep || stale {
+            if new_sweep && !stale && self.lead_in && !self.bufs[self.filling].is_complete() {
+                // The stream began mid-sweep: the part before the first sweep start is no
+                // revolution (its rpm would be made up); dropped and counted. (A stream that
+                // began at a sweep start without saying so has a whole first sweep: kept.)
+                self.stats.partial_dropped += 1;
+                self.in_progress = false;
+            } else if new_sweep || stale {
                 let period = if new_sweep && !stale {
                     (p.t_s - self.bufs[self.filling].t_start_s) as f32
                 } else {
@@ -146,6 +169,8 @@ impl PointAssembler {
             }
         }
         if !self.in_progress {
+            self.lead_in = !self.started && !new_sweep;
+            self.started = true;
             self.start(p, host_us);
         }
         self.put(p);
@@ -169,12 +194,30 @@ impl PointAssembler {
         }
     }
 
-    /// Hands out the revolution being filled, whatever its state (end of stream).
-    pub fn flush(&mut self, nominal_period_s: f32) -> Option<&Revolution> {
+    /// Hands out the revolution being filled, whatever its coverage: for a source whose scans
+    /// are whole as they come (a log's 180° scan), not for a cut-off sweep.
+    pub fn hand_out(&mut self, period_s: f32) -> Option<&Revolution> {
         if self.in_progress {
+            self.finish(period_s);
+            self.last()
+        } else {
+            None
+        }
+    }
+
+    /// End of stream: hands out the revolution being filled if the sweep got all round
+    /// (every sector has data); an unfinished one is dropped and counted
+    /// ([`PointStats::partial_dropped`]), not made into a frame.
+    pub fn flush(&mut self, nominal_period_s: f32) -> Option<&Revolution> {
+        if !self.in_progress {
+            return None;
+        }
+        if self.bufs[self.filling].is_complete() {
             self.finish(nominal_period_s);
             self.last()
         } else {
+            self.stats.partial_dropped += 1;
+            self.in_progress = false;
             None
         }
     }
@@ -188,7 +231,7 @@ impl PointAssembler {
         rev.packets = 0;
         rev.present = 0;
         rev.bad_checksum_packets = 0;
-        rev.sweep_start_bin = bin_of(p.angle_deg) as u16;
+        rev.sweep_start_bin = bin_of(p.sweep_deg) as u16;
         self.next_seq = self.next_seq.wrapping_add(1);
         self.in_progress = true;
     }
@@ -215,7 +258,7 @@ impl PointAssembler {
                 valid,
             };
         }
-        let k = rev.sector_of(d);
+        let k = rev.sector_of(bin_of(p.sweep_deg));
         if rev.present & (1 << k) == 0 {
             rev.present |= 1 << k;
             rev.packets += 1;
@@ -259,6 +302,7 @@ mod test {
             // Clockwise from 0°: φ = 360 − 360·i/n.
             let p = Point {
                 angle_deg: 360.0 - 360.0 * i as f32 / n as f32,
+                sweep_deg: 360.0 - 360.0 * i as f32 / n as f32,
                 range_m: range(i),
                 intensity: 10,
                 t_s: t0 + 0.2 * i as f64 / n as f64,
@@ -287,24 +331,27 @@ mod test {
     #[test]
     fn closest_return_wins_and_no_return_never_beats_a_return() {
         let mut a = PointAssembler::new(cfg());
-        let mut push = |deg: f32, r: f32| {
+        let mut push = |deg: f32, r: f32, new_sweep: bool| {
             a.push(
                 &Point {
                     angle_deg: deg,
+                    sweep_deg: deg,
                     range_m: r,
                     intensity: 1,
                     t_s: 0.0,
                 },
-                false,
+                new_sweep,
                 0.2,
                 None,
             )
         };
-        push(10.2, 2.0);
-        push(9.8, 1.5);
-        push(10.4, 0.0);
-        push(10.1, 3.0);
-        let rev = a.flush(0.2).unwrap();
+        push(10.2, 2.0, true);
+        push(9.8, 1.5, false);
+        push(10.4, 0.0, false);
+        push(10.1, 3.0, false);
+        // The next sweep's first point hands the revolution out.
+        assert!(push(0.0, 1.0, true));
+        let rev = a.last().unwrap();
         assert_eq!(rev.readings[10].range_m, 1.5);
         assert!(rev.readings[10].valid);
     }
@@ -320,17 +367,95 @@ mod test {
             }
             let p = Point {
                 angle_deg: 360.0 - 360.0 * i as f32 / 460.0,
+                sweep_deg: 360.0 - 360.0 * i as f32 / 460.0,
                 range_m: 1.0,
                 intensity: 1,
                 t_s: 0.2 + 0.2 * i as f64 / 460.0,
             };
             a.push(&p, i == 0, 0.2, None);
         }
-        let rev = a.flush(0.2).unwrap();
+        // The third sweep's first point hands the second revolution out.
+        let p = Point {
+            angle_deg: 0.0,
+            sweep_deg: 0.0,
+            range_m: 1.0,
+            intensity: 1,
+            t_s: 0.4,
+        };
+        assert!(a.push(&p, true, 0.2, None));
+        let rev = a.last().unwrap();
         assert!(!rev.is_complete());
         let missing = rev.missing_packets();
         assert!((6..=8).contains(&missing), "{missing}");
         assert_eq!(a.stats().missing_sectors, u64::from(missing));
+    }
+
+    #[test]
+    fn a_lead_in_and_an_unfinished_end_are_not_frames() {
+        let mut a = PointAssembler::new(cfg());
+        // The stream starts a third of the way round: no sweep start yet.
+        for i in 150..460usize {
+            let deg = 360.0 - 360.0 * i as f32 / 460.0;
+            let p = Point {
+                angle_deg: deg,
+                sweep_deg: deg,
+                range_m: 1.0,
+                intensity: 1,
+                t_s: 0.2 * i as f64 / 460.0,
+            };
+            assert!(!a.push(&p, false, 0.2, None));
+        }
+        // One whole sweep, then half of the next: one frame, both partial ends dropped.
+        assert!(!sweep(&mut a, 460, 0.2, |_| 1.0), "the lead-in is no frame");
+        assert_eq!(a.stats().partial_dropped, 1);
+        let mut frames = 0;
+        for i in 0..230usize {
+            let deg = 360.0 - 360.0 * i as f32 / 460.0;
+            let p = Point {
+                angle_deg: deg,
+                sweep_deg: deg,
+                range_m: 1.0,
+                intensity: 1,
+                t_s: 0.4 + 0.2 * i as f64 / 460.0,
+            };
+            frames += usize::from(a.push(&p, i == 0, 0.2, None));
+        }
+        assert_eq!(frames, 1, "the whole sweep is handed out");
+        let rev = a.last().unwrap();
+        assert!(rev.is_complete());
+        assert!((rev.rpm - 300.0).abs() < 1.0, "{}", rev.rpm);
+        assert!(
+            a.flush(0.2).is_none(),
+            "half a sweep at the end is no frame"
+        );
+        assert_eq!(a.stats().partial_dropped, 2);
+        assert_eq!(a.stats().revolutions, 1);
+        assert_eq!(a.stats().missing_sectors, 0);
+    }
+
+    #[test]
+    fn corrected_points_keep_their_sweep_sector() {
+        // A geometry correction (the LDS-02's) moves returns up to ~7° against the sweep while
+        // no-returns stay: the sectors follow the sweep, so nothing looks lost.
+        let mut a = PointAssembler::new(cfg());
+        let mut frames = 0;
+        for rev in 0..3usize {
+            for i in 0..460usize {
+                let sweep_deg = 360.0 - 360.0 * i as f32 / 460.0;
+                let returned = (i / 40) % 2 == 0;
+                let p = Point {
+                    angle_deg: if returned { sweep_deg + 6.8 } else { sweep_deg },
+                    sweep_deg,
+                    range_m: if returned { 2.0 } else { 0.0 },
+                    intensity: 1,
+                    t_s: 0.2 * (rev as f64 + i as f64 / 460.0),
+                };
+                frames += usize::from(a.push(&p, i == 0, 0.2, None));
+            }
+        }
+        assert_eq!(frames, 2);
+        assert_eq!(a.stats().missing_sectors, 0);
+        assert_eq!(a.stats().incomplete_revolutions, 0);
     }
 
     #[test]

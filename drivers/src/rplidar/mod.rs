@@ -138,6 +138,7 @@ impl RplidarStream {
         }
         let p = Point {
             angle_deg: 180.0 - raw,
+            sweep_deg: 180.0 - raw,
             range_m: n.distance_m(),
             intensity: u16::from(n.quality) << 2,
             t_s,
@@ -207,6 +208,7 @@ impl RevolutionStream for RplidarStream {
             bad_index: d.bad_angle,
             missing_packets: p.missing_sectors,
             incomplete_revolutions: p.incomplete_revolutions,
+            partial_revolutions_dropped: p.partial_dropped,
             sensor_errors: self.stats.health_errors,
             ..LidarFaults::default()
         }

@@ -1,0 +1,643 @@
+//! The world model's tracks: objects in the map frame that persist across frames, keep a
+//! stable id (never reused), gather evidence from both methods and leave when the LiDAR shows
+//! their place empty. Fixed capacity, allocation-free, `no_std`.
+//!
+//! Each frame ([`Tracks::update`]):
+//! 1. **Gate and associate.** Every (track, observation) pair within [`TrackConfig::gate_m`]
+//!    whose classes may be the same object (a door frame only with a door frame; the furniture
+//!    classes with each other, at a cost) is a candidate; the cheapest pair is taken first
+//!    until none is left (greedy on the global minimum).
+//! 2. **Update matched tracks:** the centre is a score-weighted running mean (total weight
+//!    capped, so a moved object is followed), the class evidence adds the observation's score
+//!    to its class, existence rises by `hit_gain × score`, the evidence flags note which
+//!    method saw it.
+//! 3. **Negative evidence** for every unmatched track in range: when the revolution's rays
+//!    across the track's footprint all returned from beyond it, the place was seen empty and
+//!    existence falls by `free_loss`. Rays that end inside the footprint (a chair's legs) or
+//!    before it (something in front) say nothing.
+//! 4. **New tracks** from unmatched observations (non-finite or absurd ones are refused and
+//!    counted); when the table is full the weakest tentative track, else the weakest track, is
+//!    evicted (counted).
+//! 5. **Confirmation and deletion:** a track is reported ([`Track::confirmed`]) once it has
+//!    [`TrackConfig::confirm_hits`] hits and existence above [`TrackConfig::confirm_existence`];
+//!    it is deleted when existence falls below [`TrackConfig::delete_existence`], or when a
+//!    tentative track goes unseen for [`TrackConfig::tentative_frames`]. A track out of view
+//!    keeps its state: an object behind the robot is still in the room.
+//!
+//! This module is the core the frame loop's world model is built on; its wiring into the
+//! output line and its evaluation on unseen rooms are the next steps.
+
+use heapless::Vec;
+
+use crate::class::ObjectClass;
+use crate::fusion::{Evidence, FrameObject};
+use crate::geometry::{Point2, Pose2};
+
+/// Tracks held at most.
+pub const MAX_TRACKS: usize = 64;
+
+/// Bins of a revolution (1° each, counter-clockwise from the LiDAR's forward axis).
+const BINS: usize = 360;
+
+/// Tuning of the track table.
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct TrackConfig {
+    /// Farthest an observation may be from a track's centre to update it, m.
+    pub gate_m: f32,
+    /// Extra cost (m) of associating furniture of different classes.
+    pub class_change_cost_m: f32,
+    /// Hits before a track is reported.
+    pub confirm_hits: u32,
+    /// Existence before a track is reported.
+    pub confirm_existence: f32,
+    /// Existence below which a track is deleted.
+    pub delete_existence: f32,
+    /// Frames a tentative track may go unseen before it is deleted.
+    pub tentative_frames: u64,
+    /// Existence gained per hit, times the observation's score.
+    pub hit_gain: f32,
+    /// Existence lost when the place is seen empty.
+    pub free_loss: f32,
+    /// Existence is kept within ±this.
+    pub existence_cap: f32,
+    /// Total position weight at most (a cap lets a moved object be followed).
+    pub max_weight: f32,
+    /// The LiDAR's useful range, m: negative evidence only within it.
+    pub max_range_m: f32,
+    /// Farthest from the robot an observation is believed, m (beyond: refused as absurd).
+    pub max_observation_m: f32,
+}
+
+impl Default for TrackConfig {
+    fn default() -> Self {
+        TrackConfig {
+            gate_m: 0.5,
+            class_change_cost_m: 0.3,
+            confirm_hits: 3,
+            confirm_existence: 1.5,
+            delete_existence: -1.0,
+            tentative_frames: 10,
+            hit_gain: 1.0,
+            free_loss: 1.0,
+            existence_cap: 6.0,
+            max_weight: 10.0,
+            max_range_m: 3.5,
+            max_observation_m: 12.0,
+        }
+    }
+}
+
+/// One tracked object.
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct Track {
+    /// Stable id: the same object in every frame, never reused.
+    pub id: u32,
+    /// Centre in the map frame, m.
+    pub centre: Point2,
+    /// Position weight gathered (capped).
+    weight: f32,
+    /// Summed scores per class ([`ObjectClass::ALL`] order).
+    class_evidence: [f32; 4],
+    /// Log-odds-like existence.
+    pub existence: f32,
+    /// Frames with an observation.
+    pub hits: u32,
+    /// First and last frame with an observation.
+    pub first_seen: u64,
+    /// Last frame with an observation.
+    pub last_seen: u64,
+    /// Seen by Method A / by Method B so far.
+    seen_a: bool,
+    seen_b: bool,
+    /// Reported.
+    pub confirmed: bool,
+}
+
+impl Track {
+    /// The most likely class.
+    pub fn class(&self) -> ObjectClass {
+        let mut best = 0;
+        for k in 1..4 {
+            if self.class_evidence[k] > self.class_evidence[best] {
+                best = k;
+            }
+        }
+        ObjectClass::ALL[best]
+    }
+
+    /// The class's share of the evidence, in [0, 1].
+    pub fn class_score(&self) -> f32 {
+        let total: f32 = self.class_evidence.iter().sum();
+        if total > 0.0 {
+            self.class_evidence[self.class() as usize] / total
+        } else {
+            0.0
+        }
+    }
+
+    /// Which methods have seen it.
+    pub fn evidence(&self) -> Evidence {
+        match (self.seen_a, self.seen_b) {
+            (true, true) => Evidence::AB,
+            (false, true) => Evidence::B,
+            _ => Evidence::A,
+        }
+    }
+
+    /// Radius of the footprint negative evidence looks across, m (a desk's legs span ~1.8 m).
+    fn radius(&self) -> f32 {
+        match self.class() {
+            ObjectClass::Chair => 0.3,
+            ObjectClass::Box => 0.35,
+            ObjectClass::Desk => 0.9,
+            ObjectClass::DoorFrame => 0.5,
+        }
+    }
+}
+
+/// Counters of the track table.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct TrackStats {
+    /// Tracks created.
+    pub created: u64,
+    /// Tracks deleted (seen empty, or tentative and unseen).
+    pub deleted: u64,
+    /// Tracks evicted because the table was full.
+    pub evicted: u64,
+    /// Observations refused: a non-finite coordinate or score, or beyond
+    /// [`TrackConfig::max_observation_m`].
+    pub rejected: u64,
+    /// Frames whose pose could not be used (non-finite).
+    pub bad_poses: u64,
+}
+
+/// The track table.
+#[derive(Debug, Clone)]
+pub struct Tracks {
+    tracks: Vec<Track, MAX_TRACKS>,
+    /// Which tracks took an observation this frame.
+    matched: [bool; MAX_TRACKS],
+    next_id: u32,
+    stats: TrackStats,
+}
+
+impl Default for Tracks {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+/// Class compatibility cost: `None` when the two cannot be one object.
+fn class_cost(track: ObjectClass, obs: ObjectClass, cfg: &TrackConfig) -> Option<f32> {
+    use ObjectClass::DoorFrame;
+    match (track == DoorFrame, obs == DoorFrame) {
+        (true, true) => Some(0.0),
+        (false, false) if track == obs => Some(0.0),
+        (false, false) => Some(cfg.class_change_cost_m),
+        _ => None,
+    }
+}
+
+impl Tracks {
+    /// An empty table.
+    pub const fn new() -> Self {
+        Tracks {
+            tracks: Vec::new(),
+            matched: [false; MAX_TRACKS],
+            next_id: 0,
+            stats: TrackStats {
+                created: 0,
+                deleted: 0,
+                evicted: 0,
+                rejected: 0,
+                bad_poses: 0,
+            },
+        }
+    }
+
+    /// Every track, confirmed or not.
+    pub fn all(&self) -> &[Track] {
+        &self.tracks
+    }
+
+    /// The confirmed tracks: the map's objects.
+    pub fn confirmed(&self) -> impl Iterator<Item = &Track> + '_ {
+        self.tracks.iter().filter(|t| t.confirmed)
+    }
+
+    /// Counters.
+    pub fn stats(&self) -> &TrackStats {
+        &self.stats
+    }
+
+    /// One frame: `obs` are the frame's objects (map frame), `lidar` the LiDAR's pose in the
+    /// map at the revolution, `ranges` its 360 bins (0 = no return).
+    pub fn update(
+        &mut self,
+        frame: u64,
+        obs: &[FrameObject],
+        lidar: &Pose2,
+        ranges: &[f32; BINS],
+        cfg: &TrackConfig,
+    ) {
+        let pose_ok = lidar.x.is_finite() && lidar.y.is_finite() && lidar.theta.is_finite();
+        if !pose_ok {
+            self.stats.bad_poses += 1;
+        }
+        let sensor = Point2::new(lidar.x, lidar.y);
+        self.matched = [false; MAX_TRACKS];
+        let mut used: [bool; crate::fusion::MAX_FRAME_OBJECTS] =
+            [false; crate::fusion::MAX_FRAME_OBJECTS];
+        let obs = &obs[..obs.len().min(used.len())];
+        // Refuse what cannot be true.
+        for (k, o) in obs.iter().enumerate() {
+            let finite = o.centre.x.is_finite() && o.centre.y.is_finite() && o.score.is_finite();
+            let near = pose_ok && o.centre.distance(sensor) <= cfg.max_observation_m;
+            if !(finite && near) {
+                used[k] = true;
+                self.stats.rejected += 1;
+            }
+        }
+        // Greedy on the global minimum cost.
+        loop {
+            let mut best: Option<(f32, usize, usize)> = None;
+            for (i, t) in self.tracks.iter().enumerate() {
+                if self.matched[i] {
+                    continue;
+                }
+                for (k, o) in obs.iter().enumerate() {
+                    if used[k] {
+                        continue;
+                    }
+                    let d = t.centre.distance(o.centre);
+                    if d > cfg.gate_m {
+                        continue;
+                    }
+                    let Some(extra) = class_cost(t.class(), o.class, cfg) else {
+                        continue;
+                    };
+                    let cost = d + extra;
+                    if best.is_none_or(|b| cost < b.0) {
+                        best = Some((cost, i, k));
+                    }
+                }
+            }
+            let Some((_, i, k)) = best else { break };
+            self.matched[i] = true;
+            used[k] = true;
+            Self::hit(&mut self.tracks[i], &obs[k], frame, cfg);
+        }
+        // Negative evidence for the unmatched tracks in view.
+        if pose_ok {
+            for (i, t) in self.tracks.iter_mut().enumerate() {
+                if !self.matched[i] && seen_empty(t, lidar, ranges, cfg) {
+                    t.existence = (t.existence - cfg.free_loss).max(-cfg.existence_cap);
+                }
+            }
+        }
+        // Deletion.
+        let mut i = 0;
+        while i < self.tracks.len() {
+            let t = &self.tracks[i];
+            let stale_tentative =
+                !t.confirmed && frame.saturating_sub(t.last_seen) > cfg.tentative_frames;
+            if t.existence < cfg.delete_existence || stale_tentative {
+                self.tracks.swap_remove(i);
+                self.matched.swap(i, self.tracks.len().min(MAX_TRACKS - 1));
+                self.stats.deleted += 1;
+            } else {
+                i += 1;
+            }
+        }
+        // New tracks.
+        for (k, o) in obs.iter().enumerate() {
+            if used[k] {
+                continue;
+            }
+            if self.tracks.is_full() {
+                self.evict_weakest();
+            }
+            let mut t = Track {
+                id: self.next_id,
+                centre: o.centre,
+                weight: 0.0,
+                class_evidence: [0.0; 4],
+                existence: 0.0,
+                hits: 0,
+                first_seen: frame,
+                last_seen: frame,
+                seen_a: false,
+                seen_b: false,
+                confirmed: false,
+            };
+            Self::hit(&mut t, o, frame, cfg);
+            if self.tracks.push(t).is_ok() {
+                self.next_id = self.next_id.wrapping_add(1);
+                self.stats.created += 1;
+            }
+        }
+    }
+
+    fn hit(t: &mut Track, o: &FrameObject, frame: u64, cfg: &TrackConfig) {
+        let w = o.score.clamp(0.05, 1.0);
+        let total = t.weight + w;
+        t.centre = Point2::new(
+            (t.centre.x * t.weight + o.centre.x * w) / total,
+            (t.centre.y * t.weight + o.centre.y * w) / total,
+        );
+        t.weight = total.min(cfg.max_weight);
+        t.class_evidence[o.class as usize] += o.score.clamp(0.0, 1.0);
+        t.existence = (t.existence + cfg.hit_gain * w).min(cfg.existence_cap);
+        t.hits = t.hits.saturating_add(1);
+        t.last_seen = frame;
+        match o.evidence {
+            Evidence::A => t.seen_a = true,
+            Evidence::B => t.seen_b = true,
+            Evidence::AB => {
+                t.seen_a = true;
+                t.seen_b = true;
+            }
+        }
+        if t.hits >= cfg.confirm_hits && t.existence >= cfg.confirm_existence {
+            t.confirmed = true;
+        }
+    }
+
+    /// Makes room: the weakest tentative track goes, else the weakest of all.
+    fn evict_weakest(&mut self) {
+        let weakest = |only_tentative: bool| {
+            self.tracks
+                .iter()
+                .enumerate()
+                .filter(|(_, t)| !only_tentative || !t.confirmed)
+                .min_by(|a, b| a.1.existence.total_cmp(&b.1.existence))
+                .map(|(i, _)| i)
+        };
+        if let Some(i) = weakest(true).or_else(|| weakest(false)) {
+            self.tracks.swap_remove(i);
+            self.stats.evicted += 1;
+        }
+    }
+}
+
+/// Whether this revolution saw the track's footprint empty: at least two rays cross it and
+/// every ray that returned did so from beyond it (none inside, none in front).
+fn seen_empty(t: &Track, lidar: &Pose2, ranges: &[f32; BINS], cfg: &TrackConfig) -> bool {
+    let local = lidar.inverse().transform(t.centre);
+    let dist = libm::sqrtf(local.x * local.x + local.y * local.y);
+    let r = t.radius();
+    if dist <= r || dist + r > cfg.max_range_m {
+        return false;
+    }
+    let bearing = libm::atan2f(local.y, local.x).to_degrees();
+    let half = libm::asinf((r / dist).min(1.0)).to_degrees();
+    let (lo, hi) = (
+        libm::ceilf(bearing - half) as i32,
+        libm::floorf(bearing + half) as i32,
+    );
+    let mut beyond = 0;
+    for d in lo..=hi {
+        let range = ranges[d.rem_euclid(BINS as i32) as usize];
+        if range <= 0.0 || !range.is_finite() {
+            continue; // no return: says nothing (dark surfaces drop out)
+        }
+        if range < dist + r {
+            return false; // something inside the footprint, or in front of it
+        }
+        beyond += 1;
+    }
+    beyond >= 2
+}
+
+#[cfg(test)]
+mod test {
+    use super::*;
+
+    fn obs(class: ObjectClass, x: f32, y: f32, score: f32, evidence: Evidence) -> FrameObject {
+        FrameObject {
+            class,
+            centre: Point2::new(x, y),
+            score,
+            evidence,
+            bbox: None,
+        }
+    }
+
+    /// A revolution from the origin facing +x with every ray returning at `r` m.
+    fn ranges(r: f32) -> [f32; BINS] {
+        [r; BINS]
+    }
+
+    const CHAIR: ObjectClass = ObjectClass::Chair;
+
+    #[test]
+    fn ids_are_stable_and_tracks_confirm_after_three_hits() {
+        let mut t = Tracks::new();
+        let cfg = TrackConfig::default();
+        let scan = ranges(0.0);
+        for f in 0..5u64 {
+            // Two chairs, listed in a different order every frame, with a little noise.
+            let j = f as f32 * 0.01;
+            let a = obs(CHAIR, 1.0 + j, 0.0, 0.8, Evidence::A);
+            let b = obs(ObjectClass::Box, -1.0, 1.0 - j, 0.9, Evidence::B);
+            let list = if f % 2 == 0 { [a, b] } else { [b, a] };
+            t.update(f, &list, &Pose2::IDENTITY, &scan, &cfg);
+            assert_eq!(t.all().len(), 2);
+            assert_eq!(
+                t.confirmed().count(),
+                if f >= 2 { 2 } else { 0 },
+                "frame {f}"
+            );
+        }
+        let chair = t.all().iter().find(|x| x.class() == CHAIR).unwrap();
+        let boxx = t
+            .all()
+            .iter()
+            .find(|x| x.class() == ObjectClass::Box)
+            .unwrap();
+        assert_eq!(
+            (chair.id, boxx.id),
+            (0, 1),
+            "first seen, first numbered; never renumbered"
+        );
+        assert_eq!(chair.hits, 5);
+        assert_eq!(chair.evidence(), Evidence::A);
+        assert_eq!(boxx.evidence(), Evidence::B);
+        assert!((chair.centre.x - 1.02).abs() < 0.02, "{:?}", chair.centre);
+    }
+
+    #[test]
+    fn a_flickering_phantom_is_never_confirmed_and_dies_unseen() {
+        let mut t = Tracks::new();
+        let cfg = TrackConfig::default();
+        let scan = ranges(0.0);
+        t.update(
+            0,
+            &[obs(CHAIR, 2.0, 0.0, 0.5, Evidence::A)],
+            &Pose2::IDENTITY,
+            &scan,
+            &cfg,
+        );
+        for f in 1..=cfg.tentative_frames + 1 {
+            t.update(f, &[], &Pose2::IDENTITY, &scan, &cfg);
+            assert_eq!(t.confirmed().count(), 0);
+        }
+        assert!(t.all().is_empty());
+        assert_eq!(t.stats().deleted, 1);
+    }
+
+    #[test]
+    fn a_moved_object_leaves_when_its_place_is_seen_empty() {
+        let mut t = Tracks::new();
+        let cfg = TrackConfig::default();
+        // A box 2 m ahead: its rays return at 2 m.
+        let mut scan = ranges(3.4);
+        for d in [358usize, 359, 0, 1, 2] {
+            scan[d] = 1.9;
+        }
+        for f in 0..6 {
+            t.update(
+                f,
+                &[obs(ObjectClass::Box, 2.0, 0.0, 0.9, Evidence::AB)],
+                &Pose2::IDENTITY,
+                &scan,
+                &cfg,
+            );
+        }
+        assert_eq!(t.confirmed().count(), 1);
+        // It is carried away: the rays now reach the wall behind.
+        let empty = ranges(3.4);
+        let mut frames = 0;
+        while !t.all().is_empty() {
+            frames += 1;
+            assert!(frames < 20, "still there after {frames} frames");
+            t.update(5 + frames, &[], &Pose2::IDENTITY, &empty, &cfg);
+        }
+        assert!(frames <= 10, "gone within 2 s (10 frames): {frames}");
+    }
+
+    #[test]
+    fn out_of_view_or_occluded_tracks_keep_their_state() {
+        let mut t = Tracks::new();
+        let cfg = TrackConfig::default();
+        let scan = ranges(0.0);
+        for f in 0..4 {
+            t.update(
+                f,
+                &[obs(CHAIR, 2.0, 0.0, 0.9, Evidence::A)],
+                &Pose2::IDENTITY,
+                &scan,
+                &cfg,
+            );
+        }
+        let before = t.all()[0];
+        // Something stands in front of it (returns at 1 m), then nothing returns at all.
+        for (f, scan) in [(4, ranges(1.0)), (5, ranges(0.0))] {
+            t.update(f, &[], &Pose2::IDENTITY, &scan, &cfg);
+        }
+        assert_eq!(t.all()[0].existence, before.existence);
+        assert!(t.all()[0].confirmed);
+    }
+
+    #[test]
+    fn legs_inside_the_footprint_are_not_seen_as_empty() {
+        let mut t = Tracks::new();
+        let cfg = TrackConfig::default();
+        // A chair 2 m ahead: rays pass between its legs (to 3.4 m) except two on legs.
+        let mut scan = ranges(3.4);
+        scan[4] = 2.1;
+        scan[356] = 1.9;
+        for f in 0..8 {
+            let o = [obs(CHAIR, 2.0, 0.0, 0.9, Evidence::A)];
+            let seen: &[FrameObject] = if f < 4 { &o } else { &[] };
+            t.update(f, seen, &Pose2::IDENTITY, &scan, &cfg);
+        }
+        assert!(t.all()[0].confirmed, "legs in the footprint keep it");
+        assert_eq!(
+            t.all()[0].existence,
+            t.all()[0].existence.min(cfg.existence_cap)
+        );
+    }
+
+    #[test]
+    fn bad_input_is_counted_not_tracked() {
+        let mut t = Tracks::new();
+        let cfg = TrackConfig::default();
+        let scan = ranges(0.0);
+        let bad = [
+            obs(CHAIR, f32::NAN, 0.0, 0.9, Evidence::A),
+            obs(CHAIR, 1.0, 0.0, f32::INFINITY, Evidence::A),
+            obs(CHAIR, 1e9, 0.0, 0.9, Evidence::A),
+        ];
+        t.update(0, &bad, &Pose2::IDENTITY, &scan, &cfg);
+        assert!(t.all().is_empty());
+        assert_eq!(t.stats().rejected, 3);
+        let lost = Pose2::new(f32::NAN, 0.0, 0.0);
+        t.update(
+            1,
+            &[obs(CHAIR, 1.0, 0.0, 0.9, Evidence::A)],
+            &lost,
+            &scan,
+            &cfg,
+        );
+        assert_eq!(t.stats().bad_poses, 1);
+        assert!(
+            t.all().is_empty(),
+            "nothing is placed from a pose that is not known"
+        );
+    }
+
+    #[test]
+    fn a_full_table_evicts_the_weakest_and_counts_it() {
+        let mut t = Tracks::new();
+        let cfg = TrackConfig::default();
+        let scan = ranges(0.0);
+        // One strong confirmed track, then more tentative ones than fit.
+        for f in 0..4 {
+            t.update(
+                f,
+                &[obs(CHAIR, 0.0, 5.0, 1.0, Evidence::AB)],
+                &Pose2::IDENTITY,
+                &scan,
+                &cfg,
+            );
+        }
+        let mut many: Vec<FrameObject, 80> = Vec::new();
+        for k in 0..70 {
+            let (x, y) = ((k % 10) as f32 - 4.5, -2.0 - (k / 10) as f32);
+            let _ = many.push(obs(ObjectClass::Box, x, y, 0.3, Evidence::B));
+        }
+        t.update(4, &many, &Pose2::IDENTITY, &scan, &cfg);
+        assert_eq!(t.all().len(), MAX_TRACKS);
+        assert_eq!(t.stats().evicted, 70 + 1 - MAX_TRACKS as u64);
+        assert!(
+            t.all().iter().any(|x| x.confirmed && x.id == 0),
+            "the strong track stays"
+        );
+    }
+
+    #[test]
+    fn door_frames_and_furniture_never_merge() {
+        let mut t = Tracks::new();
+        let cfg = TrackConfig::default();
+        let scan = ranges(0.0);
+        t.update(
+            0,
+            &[obs(ObjectClass::DoorFrame, 1.0, 0.0, 0.9, Evidence::A)],
+            &Pose2::IDENTITY,
+            &scan,
+            &cfg,
+        );
+        t.update(
+            1,
+            &[obs(CHAIR, 1.1, 0.0, 0.9, Evidence::B)],
+            &Pose2::IDENTITY,
+            &scan,
+            &cfg,
+        );
+        assert_eq!(t.all().len(), 2);
+    }
+}
