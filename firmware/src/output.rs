@@ -6,6 +6,7 @@ use std::io::{self, Write};
 use drivers::lidar::{LidarFaults, Revolution};
 use perception::class::ObjectClass;
 use perception::fusion::{Evidence, FrameObject};
+use perception::tracks::Track;
 use serde::{Serialize, Serializer};
 
 /// Pose in the map frame.
@@ -36,9 +37,16 @@ pub struct ObjectOut {
     /// `A`, `B` or `AB`.
     #[serde(serialize_with = "evidence_name")]
     pub source: Evidence,
-    /// Method B's box `[cx, cy, w, h]` in pixels of the 384 × 64 input (B and AB only).
+    /// Method B's box `[cx, cy, w, h]` in pixels of the 384 × 64 input (a frame's B and AB
+    /// detections only).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub bbox: Option<[f64; 4]>,
+    /// Frames that observed the object (tracks only).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub hits: Option<u32>,
+    /// The last frame that observed it (tracks only).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub last_seen: Option<u64>,
 }
 
 impl ObjectOut {
@@ -52,6 +60,25 @@ impl ObjectOut {
             score: f64::from(o.score),
             source: o.evidence,
             bbox: o.bbox.map(|b| b.map(f64::from)),
+            hits: None,
+            last_seen: None,
+        }
+    }
+
+    /// A confirmed track of the world model: its stable id, its most likely class, and a
+    /// score that is the belief it exists times the class's share of the evidence.
+    pub fn track(t: &Track) -> Self {
+        let exists = 1.0 / (1.0 + (-f64::from(t.existence)).exp());
+        ObjectOut {
+            id: t.id,
+            class: t.class(),
+            x: f64::from(t.centre.x),
+            y: f64::from(t.centre.y),
+            score: exists * f64::from(t.class_score()),
+            source: t.evidence(),
+            bbox: None,
+            hits: Some(t.hits),
+            last_seen: Some(t.last_seen),
         }
     }
 }
@@ -242,12 +269,17 @@ pub struct OutputLine<'a> {
     pub t: f64,
     /// Robot pose in the map frame.
     pub pose: PoseOut,
-    /// Recognised objects.
+    /// Recognised objects: this frame's detections, or with the world model on its confirmed
+    /// tracks (stable ids, persistent across frames).
     pub objects: &'a [ObjectOut],
     /// Wall segments.
     pub walls: &'a [WallOut],
     /// Doors.
     pub doors: &'a [DoorOut],
+    /// With the world model on (`[world] enabled`): this frame's detections from both methods
+    /// (`id` is the place in this list), while `objects` are the confirmed tracks.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub detections: Option<&'a [ObjectOut]>,
     /// Stage times.
     pub timing_ms: TimingOut,
     /// The per-frame budget.
@@ -316,6 +348,7 @@ mod test {
             objects: &[],
             walls: &[],
             doors: &[],
+            detections: None,
             timing_ms: TimingOut {
                 ingest: 0.1,
                 pose: 0.0,

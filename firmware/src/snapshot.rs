@@ -263,6 +263,8 @@ mod tests {
             score: 0.97,
             source: perception::fusion::Evidence::A,
             bbox: None,
+            hits: Some(4),
+            last_seen: Some(7),
         }];
         let s = svg(&Scene {
             cloud: &cloud,

@@ -59,6 +59,9 @@ pub struct TrackConfig {
     pub hit_gain: f32,
     /// Existence lost when the place is seen empty.
     pub free_loss: f32,
+    /// Existence lost in a frame whose revolution had the track in plain view (in range, its
+    /// bearing not blocked by anything nearer) and no observation matched it.
+    pub miss_loss: f32,
     /// Existence is kept within ±this.
     pub existence_cap: f32,
     /// Total position weight at most (a cap lets a moved object be followed).
@@ -80,6 +83,7 @@ impl Default for TrackConfig {
             tentative_frames: 10,
             hit_gain: 1.0,
             free_loss: 1.0,
+            miss_loss: 0.7,
             existence_cap: 6.0,
             max_weight: 10.0,
             max_range_m: 3.5,
@@ -293,8 +297,18 @@ impl Tracks {
         // Negative evidence for the unmatched tracks in view.
         if pose_ok {
             for (i, t) in self.tracks.iter_mut().enumerate() {
-                if !self.matched[i] && seen_empty(t, lidar, ranges, cfg) {
-                    t.existence = (t.existence - cfg.free_loss).max(-cfg.existence_cap);
+                if self.matched[i] {
+                    continue;
+                }
+                let loss = match view(t, lidar, ranges, cfg) {
+                    View::Empty => cfg.free_loss,
+                    View::Plain => cfg.miss_loss,
+                    View::Hidden => 0.0,
+                };
+                t.existence = (t.existence - loss).max(-cfg.existence_cap);
+                if t.existence < cfg.confirm_existence {
+                    // Reported again only once the evidence is back.
+                    t.confirmed = false;
                 }
             }
         }
@@ -383,14 +397,24 @@ impl Tracks {
     }
 }
 
-/// Whether this revolution saw the track's footprint empty: at least two rays cross it and
-/// every ray that returned did so from beyond it (none inside, none in front).
-fn seen_empty(t: &Track, lidar: &Pose2, ranges: &[f32; BINS], cfg: &TrackConfig) -> bool {
+/// What a revolution showed of a track's footprint.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum View {
+    /// Out of range, inside the robot's own footprint, or behind something nearer.
+    Hidden,
+    /// In plain view: the rays reach it (they end inside its footprint).
+    Plain,
+    /// Seen empty: at least two rays cross it and every one that returned did so from beyond.
+    Empty,
+}
+
+/// What this revolution showed of the track's footprint.
+fn view(t: &Track, lidar: &Pose2, ranges: &[f32; BINS], cfg: &TrackConfig) -> View {
     let local = lidar.inverse().transform(t.centre);
     let dist = libm::sqrtf(local.x * local.x + local.y * local.y);
     let r = t.radius();
     if dist <= r || dist + r > cfg.max_range_m {
-        return false;
+        return View::Hidden;
     }
     let bearing = libm::atan2f(local.y, local.x).to_degrees();
     let half = libm::asinf((r / dist).min(1.0)).to_degrees();
@@ -398,18 +422,27 @@ fn seen_empty(t: &Track, lidar: &Pose2, ranges: &[f32; BINS], cfg: &TrackConfig)
         libm::ceilf(bearing - half) as i32,
         libm::floorf(bearing + half) as i32,
     );
-    let mut beyond = 0;
+    let (mut beyond, mut inside, mut before) = (0, 0, 0);
     for d in lo..=hi {
         let range = ranges[d.rem_euclid(BINS as i32) as usize];
         if range <= 0.0 || !range.is_finite() {
             continue; // no return: says nothing (dark surfaces drop out)
         }
-        if range < dist + r {
-            return false; // something inside the footprint, or in front of it
+        if range < dist - r {
+            before += 1;
+        } else if range < dist + r {
+            inside += 1;
+        } else {
+            beyond += 1;
         }
-        beyond += 1;
     }
-    beyond >= 2
+    if inside == 0 && before == 0 && beyond >= 2 {
+        View::Empty
+    } else if inside > 0 && inside >= before {
+        View::Plain
+    } else {
+        View::Hidden
+    }
 }
 
 #[cfg(test)]

@@ -87,6 +87,7 @@ fn per_frame_from(
         pose: Some(pose),
         method_a: Some((cfg.method_a(), cfg.lidar_mount())),
         method_b: b,
+        world: Some(perception::tracks::TrackConfig::default()),
     };
     let mut summary = None;
     let stream = drivers::lidar::AnyLidar::new(source.model().expect("a LiDAR"), &cfg.lidar());

@@ -309,6 +309,15 @@ impl Default for MethodASettings {
     }
 }
 
+/// `[world]`: the world model (tracks with stable ids). Off by default until it is measured
+/// to report fewer phantoms than the frame's own detections (docs/interfaces.md §3).
+#[derive(Debug, Clone, Copy, PartialEq, Default, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct WorldSettings {
+    /// `objects` become the confirmed tracks, and the frame's detections move to `detections`.
+    pub enabled: bool,
+}
+
 /// `[method_b]`: the learned pipeline's settings.
 #[derive(Debug, Clone, PartialEq, Deserialize)]
 #[serde(default, deny_unknown_fields)]
@@ -375,6 +384,8 @@ pub struct Config {
     pub method_b: MethodBSettings,
     /// Power budget and source.
     pub power: crate::power::PowerSettings,
+    /// The world model.
+    pub world: WorldSettings,
 }
 
 /// A configuration error, naming the file and field.

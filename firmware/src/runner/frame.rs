@@ -10,6 +10,7 @@ use perception::cloud::Scan;
 use perception::fusion::{FrameObjects, merge_b, push_a};
 use perception::geometry::{Point2, Pose2};
 use perception::method_a::{MethodA, MethodAConfig};
+use perception::tracks::Tracks;
 
 use super::FrameLoop;
 use super::history::ScanHistory;
@@ -32,6 +33,8 @@ pub(super) struct FrameState {
     b_scratch: MethodBScratch,
     /// This frame's objects from both methods.
     fused: Box<FrameObjects>,
+    /// The world model: objects over frames, with stable ids.
+    tracks: Box<Tracks>,
     method_b_errors: u64,
     /// Host time spent in frames (taken off the link clock).
     pub(super) busy: Duration,
@@ -47,7 +50,10 @@ pub(super) struct FrameState {
     pub(super) power_sum: f64,
     pub(super) power_n: u64,
     pub(super) power_peak: f64,
+    /// The confirmed tracks, as the line carries them.
     pub(super) objects: Vec<ObjectOut>,
+    /// This frame's detections, as the line carries them.
+    detections: Vec<ObjectOut>,
     pub(super) walls: Vec<WallOut>,
     pub(super) doors: Vec<DoorOut>,
     /// While recording: the LiDAR bytes read since the recorder last took them.
@@ -70,6 +76,7 @@ impl FrameState {
             history: Box::default(),
             b_scratch: MethodBScratch::default(),
             fused: Box::default(),
+            tracks: Box::default(),
             method_b_errors: 0,
             busy: Duration::ZERO,
             policy: Policy::default(),
@@ -80,6 +87,7 @@ impl FrameState {
             power_n: 0,
             power_peak: 0.0,
             objects: Vec::with_capacity(perception::fusion::MAX_FRAME_OBJECTS),
+            detections: Vec::with_capacity(perception::fusion::MAX_FRAME_OBJECTS),
             walls: Vec::with_capacity(perception::walls::MAX_SEGMENTS),
             doors: Vec::with_capacity(perception::doors::MAX_DOORS),
             recording: recording.then(|| RecordingInput {
@@ -259,10 +267,28 @@ impl<S: RevolutionStream> FrameLoop<'_, S> {
             _ => None,
         };
 
-        // The frame's objects: ids are places in this frame's list.
-        st.objects.clear();
+        // The world model, when on: this frame's detections update the tracks, seen from the
+        // LiDAR's pose at the middle of the revolution; the confirmed tracks are the line's
+        // objects. Off, the objects are the frame's detections.
+        let mount = match (&opts.method_a, &opts.method_b) {
+            (Some((_, m)), _) => *m,
+            (None, Some(b)) => b.mount,
+            (None, None) => Pose2::IDENTITY,
+        };
+        st.detections.clear();
         for (id, o) in st.fused.iter().enumerate() {
-            st.objects.push(ObjectOut::new(id, o));
+            st.detections.push(ObjectOut::new(id, o));
+        }
+        st.objects.clear();
+        if let Some(cfg) = opts.world.as_ref() {
+            let lidar = midway(&pose.start, &pose.end).compose(&mount);
+            st.tracks
+                .update(frame, &st.fused, &lidar, st.history.newest(), cfg);
+            for t in st.tracks.confirmed() {
+                st.objects.push(ObjectOut::track(t));
+            }
+        } else {
+            st.objects.extend_from_slice(&st.detections);
         }
 
         // Times, the deadline, the power.
@@ -297,11 +323,7 @@ impl<S: RevolutionStream> FrameLoop<'_, S> {
         let journal = opts.pose.as_ref().and_then(|p| p.state.journal.as_ref());
         let view = FrameView {
             rev,
-            mount: match (&opts.method_a, &opts.method_b) {
-                (Some((_, m)), _) => *m,
-                (None, Some(b)) => b.mount,
-                (None, None) => Pose2::IDENTITY,
-            },
+            mount,
             ranges: st.history.newest(),
             pose: pose.start,
             raw: st.recording.as_ref().map_or(&[], |r| &r.raw[..]),
@@ -317,6 +339,7 @@ impl<S: RevolutionStream> FrameLoop<'_, S> {
                 objects: &st.objects,
                 walls: &st.walls,
                 doors: &st.doors,
+                detections: opts.world.is_some().then_some(&st.detections[..]),
                 timing_ms: TimingOut::from(times),
                 deadline_ms: opts.budgets.deadline_ms,
                 deadline_missed: missed,

@@ -28,6 +28,7 @@ use std::time::{Duration, Instant};
 
 use perception::geometry::Pose2;
 use perception::method_a::MethodAConfig;
+use perception::tracks::TrackConfig;
 
 pub use history::{METHOD_B_HISTORY, ScanHistory};
 pub use method_b::{MethodBSetup, Network};
@@ -80,6 +81,8 @@ pub struct RunOptions {
     pub method_a: Option<(MethodAConfig, Pose2)>,
     /// Method B's model and settings; `None`: Method B off.
     pub method_b: Option<MethodBSetup>,
+    /// The world model's settings; `None`: off (`objects` are the frame's detections).
+    pub world: Option<TrackConfig>,
 }
 
 /// Runs the loop until a limit, the end of the source, or the stop flag.
