@@ -583,16 +583,24 @@ mod test {
         let mut scan = ranges(3.4);
         scan[4] = 2.1;
         scan[356] = 1.9;
-        for f in 0..8 {
-            let o = [obs(CHAIR, 2.0, 0.0, 0.9, Evidence::A)];
-            let seen: &[FrameObject] = if f < 4 { &o } else { &[] };
-            t.update(f, seen, &Pose2::IDENTITY, &scan, &cfg);
+        for f in 0..4 {
+            t.update(
+                f,
+                &[obs(CHAIR, 2.0, 0.0, 0.9, Evidence::A)],
+                &Pose2::IDENTITY,
+                &scan,
+                &cfg,
+            );
         }
-        assert!(t.all()[0].confirmed, "legs in the footprint keep it");
-        assert_eq!(
-            t.all()[0].existence,
-            t.all()[0].existence.min(cfg.existence_cap)
+        let seen = t.all()[0].existence;
+        // Not detected for a frame while in plain view: a missed detection, not an empty place.
+        t.update(4, &[], &Pose2::IDENTITY, &scan, &cfg);
+        let after = t.all()[0].existence;
+        assert!(
+            (seen - after - cfg.miss_loss).abs() < 1e-6,
+            "{seen} → {after}"
         );
+        assert!(cfg.miss_loss < cfg.free_loss);
     }
 
     #[test]
