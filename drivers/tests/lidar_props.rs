@@ -65,11 +65,17 @@ proptest! {
     }
 
     /// Good frames with garbage between them, in any chunking: every frame comes out, in
-    /// order, and every byte is accounted for.
+    /// order, and every byte is accounted for. The garbage holds no header byte (0x54): a
+    /// header in the garbage within a frame's length of a real frame makes a candidate that
+    /// passes the CRC-8 once in 256 and then covers the real frame's header — a loss no
+    /// decoder can avoid (CI once drew one); the corruption tests measure those rates.
     #[test]
     fn ldrobot_stream_finds_every_frame(
         frames in prop::collection::vec(arb_frame(), 1..20),
-        garbage in prop::collection::vec(prop::collection::vec(any::<u8>(), 0..60), 20),
+        garbage in prop::collection::vec(
+            prop::collection::vec(any::<u8>().prop_map(|b| if b == 0x54 { 0x55 } else { b }), 0..60),
+            20,
+        ),
         chunks in prop::collection::vec(1usize..100, 1..8),
     ) {
         let mut bytes = Vec::new();
@@ -89,7 +95,7 @@ proptest! {
                 }
             }
         });
-        // Garbage may form extra valid frames (1 in 256 after a 0x54 0x2C), never fewer.
+        // No header in the garbage: exactly the frames sent, never fewer.
         let mut it = out.iter();
         for f in &frames {
             prop_assert!(it.any(|g| g == f), "frame lost");
