@@ -182,8 +182,6 @@ pub struct TrackStats {
 #[derive(Debug, Clone)]
 pub struct Tracks {
     tracks: Vec<Track, MAX_TRACKS>,
-    /// Which tracks took an observation this frame.
-    matched: [bool; MAX_TRACKS],
     next_id: u32,
     stats: TrackStats,
 }
@@ -210,7 +208,6 @@ impl Tracks {
     pub const fn new() -> Self {
         Tracks {
             tracks: Vec::new(),
-            matched: [false; MAX_TRACKS],
             next_id: 0,
             stats: TrackStats {
                 created: 0,
@@ -252,7 +249,8 @@ impl Tracks {
             self.stats.bad_poses += 1;
         }
         let sensor = Point2::new(lidar.x, lidar.y);
-        self.matched = [false; MAX_TRACKS];
+        // Which tracks took an observation this frame.
+        let mut matched = [false; MAX_TRACKS];
         let mut used: [bool; crate::fusion::MAX_FRAME_OBJECTS] =
             [false; crate::fusion::MAX_FRAME_OBJECTS];
         let obs = &obs[..obs.len().min(used.len())];
@@ -269,7 +267,7 @@ impl Tracks {
         loop {
             let mut best: Option<(f32, usize, usize)> = None;
             for (i, t) in self.tracks.iter().enumerate() {
-                if self.matched[i] {
+                if matched[i] {
                     continue;
                 }
                 for (k, o) in obs.iter().enumerate() {
@@ -290,14 +288,14 @@ impl Tracks {
                 }
             }
             let Some((_, i, k)) = best else { break };
-            self.matched[i] = true;
+            matched[i] = true;
             used[k] = true;
             Self::hit(&mut self.tracks[i], &obs[k], frame, cfg);
         }
         // Negative evidence for the unmatched tracks in view.
         if pose_ok {
             for (i, t) in self.tracks.iter_mut().enumerate() {
-                if self.matched[i] {
+                if matched[i] {
                     continue;
                 }
                 let loss = match view(t, lidar, ranges, cfg) {
@@ -320,7 +318,6 @@ impl Tracks {
                 !t.confirmed && frame.saturating_sub(t.last_seen) > cfg.tentative_frames;
             if t.existence < cfg.delete_existence || stale_tentative {
                 self.tracks.swap_remove(i);
-                self.matched.swap(i, self.tracks.len().min(MAX_TRACKS - 1));
                 self.stats.deleted += 1;
             } else {
                 i += 1;

@@ -50,8 +50,8 @@ pub(super) struct FrameState {
     pub(super) power_sum: f64,
     pub(super) power_n: u64,
     pub(super) power_peak: f64,
-    /// The confirmed tracks, as the line carries them.
-    pub(super) objects: Vec<ObjectOut>,
+    /// The confirmed tracks, as the line carries them (world model on).
+    objects: Vec<ObjectOut>,
     /// This frame's detections, as the line carries them.
     detections: Vec<ObjectOut>,
     pub(super) walls: Vec<WallOut>,
@@ -86,7 +86,7 @@ impl FrameState {
             power_sum: 0.0,
             power_n: 0,
             power_peak: 0.0,
-            objects: Vec::with_capacity(perception::fusion::MAX_FRAME_OBJECTS),
+            objects: Vec::with_capacity(perception::tracks::MAX_TRACKS),
             detections: Vec::with_capacity(perception::fusion::MAX_FRAME_OBJECTS),
             walls: Vec::with_capacity(perception::walls::MAX_SEGMENTS),
             doors: Vec::with_capacity(perception::doors::MAX_DOORS),
@@ -94,6 +94,16 @@ impl FrameState {
                 raw: Box::new(heapless::Vec::new()),
                 dropped: 0,
             }),
+        }
+    }
+
+    /// The line's `objects`: the confirmed tracks with the world model on, else this frame's
+    /// detections.
+    pub(super) fn reported(&self, world: bool) -> &[ObjectOut] {
+        if world {
+            &self.objects
+        } else {
+            &self.detections
         }
     }
 
@@ -287,8 +297,6 @@ impl<S: RevolutionStream> FrameLoop<'_, S> {
             for t in st.tracks.confirmed() {
                 st.objects.push(ObjectOut::track(t));
             }
-        } else {
-            st.objects.extend_from_slice(&st.detections);
         }
 
         // Times, the deadline, the power.
@@ -336,7 +344,7 @@ impl<S: RevolutionStream> FrameLoop<'_, S> {
                     y: f64::from(pose.start.y),
                     theta: f64::from(pose.start.theta),
                 },
-                objects: &st.objects,
+                objects: st.reported(opts.world.is_some()),
                 walls: &st.walls,
                 doors: &st.doors,
                 detections: opts.world.is_some().then_some(&st.detections[..]),

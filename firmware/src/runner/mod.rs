@@ -236,7 +236,7 @@ impl<S: RevolutionStream> FrameLoop<'_, S> {
             sensor_seconds: s.sensor_seconds,
             cloud: &cloud,
             robot: self.st.last_pose,
-            objects: &self.st.objects,
+            objects: self.st.reported(self.opts.world.is_some()),
             walls: &self.st.walls,
             doors: &self.st.doors,
         };
