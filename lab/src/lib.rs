@@ -12,10 +12,14 @@
 //! | [`eval_b`]        | Method B scored on a dataset split: P, R, mAP50, mAP50-95 as Ultralytics does |
 //! | [`confusion_png`] | the evaluation's confusion matrix as a PNG                        |
 //! | [`pose_eval`]     | drift of odometry, compass overwrite and our fusion on the simulator |
+//! | [`world_eval`]    | `eval-world`: `umbra replay`'s world scored on two scene families |
+//! | [`annex`]         | the second scene family, written apart and never trained or tuned on |
 #![deny(unsafe_code, missing_docs)]
 
+pub mod annex;
 pub mod confusion_png;
 pub mod eval_a;
 pub mod eval_b;
 pub mod pose_eval;
 pub mod scenes_a;
+pub mod world_eval;

@@ -17,6 +17,10 @@
 //! * `umbra-lab pose-eval [--scenarios 3] [--minutes 10] [--seed 1]` prints the heading and
 //!   position drift of odometry, the compass overwrite and our fusion (`docs/pose.md`).
 //!
+//! * `umbra-lab eval-world [--family sim|annex|both] [--runs 12] [--world on|off|both]`
+//!   replays held-out runs of both scene families through the `umbra` binary and scores its
+//!   world (`docs/world.md`).
+//!
 //! Regenerating the committed forest is the two commands `forest-data` and `forest-train` with
 //! their defaults; both are deterministic.
 
@@ -136,6 +140,48 @@ enum Command {
         #[arg(long, default_value_t = 1)]
         seed: u64,
     },
+    /// The world as `umbra replay` reports it, scored on both scene families (world model on
+    /// and off): final map, phantoms per frame, identity, moved pieces, doors, people.
+    EvalWorld {
+        /// Families to run.
+        #[arg(long, value_enum, default_value = "both")]
+        family: FamilyArg,
+        /// Runs per family.
+        #[arg(long, default_value_t = 12)]
+        runs: usize,
+        /// Seconds per run.
+        #[arg(long, default_value_t = 30.0)]
+        seconds: f64,
+        /// Evaluation seed (held out: no training or tuning seed).
+        #[arg(long, default_value_t = 9001)]
+        seed: u64,
+        /// World model settings to score.
+        #[arg(long, value_enum, default_value = "both")]
+        world: WorldArg,
+        /// The `umbra` binary (default: the one beside this program).
+        #[arg(long)]
+        umbra: Option<PathBuf>,
+        /// Where the runs (bytes, ticks, truth, output lines) are written and kept.
+        #[arg(long, default_value = "target/eval-world")]
+        dir: PathBuf,
+        /// Write the counts here as JSON.
+        #[arg(long)]
+        json: Option<PathBuf>,
+    },
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+enum FamilyArg {
+    Sim,
+    Annex,
+    Both,
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+enum WorldArg {
+    On,
+    Off,
+    Both,
 }
 
 fn bar(n: usize, what: &str) -> ProgressBar {
@@ -372,6 +418,60 @@ fn run(cli: Cli) -> Result<(), String> {
         } => {
             let rows = lab::pose_eval::table(seed, scenarios, minutes * 60.0);
             print!("{}", lab::pose_eval::markdown(&rows));
+        }
+        Command::EvalWorld {
+            family,
+            runs,
+            seconds,
+            seed,
+            world,
+            umbra,
+            dir,
+            json,
+        } => {
+            use lab::world_eval::{EvalConfig, Family, evaluate, report};
+            let umbra = match umbra {
+                Some(p) => p,
+                None => std::env::current_exe()
+                    .map_err(|e| e.to_string())?
+                    .with_file_name("umbra"),
+            };
+            if !umbra.exists() {
+                return Err(format!(
+                    "{} not found: build it (`cargo build --release -p umbra-firmware`) or pass --umbra",
+                    umbra.display()
+                ));
+            }
+            let families = match family {
+                FamilyArg::Sim => vec![Family::Sim],
+                FamilyArg::Annex => vec![Family::Annex],
+                FamilyArg::Both => vec![Family::Sim, Family::Annex],
+            };
+            let world = match world {
+                WorldArg::On => vec![true],
+                WorldArg::Off => vec![false],
+                WorldArg::Both => vec![false, true],
+            };
+            let cfg = EvalConfig {
+                families,
+                runs,
+                seconds,
+                seed,
+                world,
+                umbra,
+                dir,
+            };
+            let pb = bar(runs * cfg.families.len(), "runs");
+            let out = evaluate(&cfg, |name| {
+                pb.println(name);
+                pb.inc(1);
+            })?;
+            pb.finish_and_clear();
+            print!("{}", report(&out));
+            if let Some(p) = json {
+                let text = serde_json::to_string_pretty(&out).map_err(|e| e.to_string())?;
+                std::fs::write(&p, text + "\n").map_err(|e| format!("{}: {e}", p.display()))?;
+            }
         }
     }
     Ok(())

@@ -1,0 +1,339 @@
+//! `umbra-lab eval-world`: the world as `umbra` reports it, scored against the truth of
+//! runs it has never seen, in two scene families: umbra's simulator on held-out seeds, and
+//! the annex ([`crate::annex`]), written apart and never trained or tuned on.
+//!
+//! Each run is written as a user would hand it over (LiDAR bytes, wheel ticks) and replayed
+//! through the `umbra` binary itself (`umbra replay CAPTURE --odom TICKS --jsonl -`), with the
+//! world model on or off; the output lines are scored by [`score`].
+
+pub mod score;
+pub mod sim_family;
+pub mod truth;
+
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+use crate::annex::{self, GeneratedRun};
+use score::{CLASSES, Line, Tally, ratio, score_run};
+
+/// A scene family.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Family {
+    /// umbra's simulator, held-out seeds.
+    Sim,
+    /// The annex: never trained or tuned on.
+    Annex,
+}
+
+impl Family {
+    /// Name in reports.
+    pub fn name(self) -> &'static str {
+        match self {
+            Family::Sim => "sim (held-out seeds)",
+            Family::Annex => "annex (never tuned on)",
+        }
+    }
+}
+
+/// What to evaluate.
+#[derive(Debug, Clone)]
+pub struct EvalConfig {
+    /// Families.
+    pub families: Vec<Family>,
+    /// Runs per family.
+    pub runs: usize,
+    /// Seconds per run.
+    pub seconds: f64,
+    /// Evaluation seed (never a training seed).
+    pub seed: u64,
+    /// World model settings to compare: `false` = off (objects are the frame's detections).
+    pub world: Vec<bool>,
+    /// The `umbra` binary.
+    pub umbra: PathBuf,
+    /// Where runs are written (and kept).
+    pub dir: PathBuf,
+}
+
+/// One family × world setting's result.
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct Outcome {
+    /// Family name.
+    pub family: &'static str,
+    /// World model on.
+    pub world: bool,
+    /// Summed counts.
+    pub tally: Tally,
+    /// Per run: name and its own tally.
+    pub runs: Vec<(String, Tally)>,
+}
+
+/// Generates run `i` of `family`.
+pub fn generate(family: Family, seed: u64, i: usize, seconds: f64) -> GeneratedRun {
+    match family {
+        Family::Sim => sim_family::generate(seed, i, seconds),
+        Family::Annex => {
+            let lidar = if i % 4 >= 2 {
+                drivers::lidar::LidarModel::Lds02
+            } else {
+                drivers::lidar::LidarModel::Lds01
+            };
+            annex::generate(
+                sim::dataset::scenario_seed(seed ^ 0xA11E, i),
+                seconds,
+                i % 2 == 1,
+                lidar,
+            )
+        }
+    }
+}
+
+/// Writes `run` to `dir` and replays it through `umbra` with the world model `world`.
+pub fn replay(
+    umbra: &Path,
+    dir: &Path,
+    run: &GeneratedRun,
+    world: bool,
+) -> Result<Vec<Line>, String> {
+    std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+    let write = |name: &str, bytes: &[u8]| {
+        let p = dir.join(name);
+        std::fs::write(&p, bytes).map_err(|e| format!("{}: {e}", p.display()))?;
+        Ok::<_, String>(p)
+    };
+    let capture = write("capture.bin", &run.capture)?;
+    let odom = write("odom.jsonl", run.odom.as_bytes())?;
+    let config = write(
+        if world { "world-on.toml" } else { "world-off.toml" },
+        format!(
+            "# eval-world: no frame is skipped for time on a loaded host\n[runtime]\ndeadline_ms = 10000\n[world]\nenabled = {world}\n"
+        )
+        .as_bytes(),
+    )?;
+    let out = Command::new(umbra)
+        .arg("replay")
+        .arg(&capture)
+        .arg("--odom")
+        .arg(&odom)
+        .arg("--lidar-model")
+        .arg(run.lidar.cli_name())
+        .args(["--jsonl", "-", "--quiet", "--config"])
+        .arg(&config)
+        .output()
+        .map_err(|e| format!("{}: {e}", umbra.display()))?;
+    if !out.status.success() {
+        return Err(format!(
+            "umbra replay failed ({}): {}",
+            out.status,
+            String::from_utf8_lossy(&out.stderr)
+        ));
+    }
+    let lines: Vec<Line> = String::from_utf8_lossy(&out.stdout)
+        .lines()
+        .filter_map(Line::parse)
+        .collect();
+    std::fs::write(
+        dir.join(if world {
+            "out-world-on.jsonl"
+        } else {
+            "out-world-off.jsonl"
+        }),
+        &out.stdout,
+    )
+    .map_err(|e| e.to_string())?;
+    Ok(lines)
+}
+
+/// Runs the whole evaluation; `progress` hears each finished run.
+pub fn evaluate(cfg: &EvalConfig, mut progress: impl FnMut(&str)) -> Result<Vec<Outcome>, String> {
+    let mut out = Vec::new();
+    for &family in &cfg.families {
+        let mut per: Vec<Outcome> = cfg
+            .world
+            .iter()
+            .map(|&world| Outcome {
+                family: family.name(),
+                world,
+                tally: Tally::default(),
+                runs: Vec::new(),
+            })
+            .collect();
+        for i in 0..cfg.runs {
+            let run = generate(family, cfg.seed, i, cfg.seconds);
+            let tag = match family {
+                Family::Sim => "sim",
+                Family::Annex => "annex",
+            };
+            let dir = cfg.dir.join(format!("{tag}-{i:03}"));
+            std::fs::create_dir_all(&dir).map_err(|e| e.to_string())?;
+            std::fs::write(dir.join("truth.txt"), describe(&run.truth))
+                .map_err(|e| e.to_string())?;
+            for o in &mut per {
+                let lines = replay(&cfg.umbra, &dir, &run, o.world)?;
+                let mut t = Tally::default();
+                score_run(&run.truth, &lines, &mut t);
+                o.tally.add(&t);
+                o.runs.push((run.truth.name.clone(), t));
+            }
+            progress(&run.truth.name);
+        }
+        out.extend(per);
+    }
+    Ok(out)
+}
+
+/// The run's truth in words (written beside each run).
+pub fn describe(t: &truth::RunTruth) -> String {
+    let mut s = format!("{}\n", t.name);
+    for (k, f) in t.furniture.iter().enumerate() {
+        let c = f.centre();
+        let _ = writeln!(
+            s,
+            "furniture {k} (piece {}): {} {} at ({:.2}, {:.2}), frames {}..{}, {} returns",
+            f.piece,
+            f.class.as_str(),
+            f.what,
+            c.x,
+            c.y,
+            f.from_frame,
+            if f.to_frame == usize::MAX {
+                "end".to_string()
+            } else {
+                f.to_frame.to_string()
+            },
+            f.returns
+        );
+    }
+    for d in &t.doors {
+        let _ = writeln!(
+            s,
+            "door at ({:.2}, {:.2}), {:.2} m, {} returns",
+            d.centre.x, d.centre.y, d.width, d.returns
+        );
+    }
+    for (c, w) in &t.clutter {
+        let _ = writeln!(s, "clutter: {w} at ({:.2}, {:.2})", c.x, c.y);
+    }
+    for m in &t.moves {
+        let _ = writeln!(
+            s,
+            "move: furniture {} gone from frame {}, seen empty at {:?}",
+            m.before, m.frame, m.seen_empty
+        );
+    }
+    s
+}
+
+fn pct(x: f64) -> String {
+    if x.is_nan() {
+        "  –  ".into()
+    } else {
+        format!("{x:.3}")
+    }
+}
+
+/// The report: one block per family and world setting.
+pub fn report(outcomes: &[Outcome]) -> String {
+    let mut s = String::new();
+    for o in outcomes {
+        let t = &o.tally;
+        let f = f64::from(t.frames.max(1));
+        let _ = writeln!(
+            s,
+            "\n{} — world model {} — {} runs, {} frames",
+            o.family,
+            if o.world { "ON" } else { "off" },
+            t.runs,
+            t.frames
+        );
+        let _ = writeln!(s, "  final map      precision  recall   (found/visible)");
+        for (c, name) in CLASSES.iter().enumerate() {
+            let _ = writeln!(
+                s,
+                "    {name:6}         {}      {}    ({}/{}, {} reported)",
+                pct(ratio(t.map_tp[c], t.map_reported[c])),
+                pct(ratio(t.map_tp[c], t.map_visible[c])),
+                t.map_tp[c],
+                t.map_visible[c],
+                t.map_reported[c]
+            );
+        }
+        let _ = writeln!(
+            s,
+            "    against a wall recall {} ({}/{}), in the open {} ({}/{})",
+            pct(ratio(t.wall_found[0], t.wall_found[1])),
+            t.wall_found[0],
+            t.wall_found[1],
+            pct(ratio(t.open_found[0], t.open_found[1])),
+            t.open_found[0],
+            t.open_found[1]
+        );
+        let _ = writeln!(
+            s,
+            "  doors (`doors`) precision {} recall {} ({}/{}, {} reported); as door_frame objects {}/{}",
+            pct(ratio(t.doors[0], t.doors[1])),
+            pct(ratio(t.doors[0], t.doors[2])),
+            t.doors[0],
+            t.doors[2],
+            t.doors[1],
+            t.door_frames_found,
+            t.doors[2]
+        );
+        let ph = |p: &[u32; 3], fr: f64| {
+            format!(
+                "{:.3} (A {:.3}, B {:.3}, AB {:.3})",
+                f64::from(p.iter().sum::<u32>()) / fr,
+                f64::from(p[0]) / fr,
+                f64::from(p[1]) / fr,
+                f64::from(p[2]) / fr
+            )
+        };
+        let _ = writeln!(
+            s,
+            "  phantoms/frame among objects {}; wrong class/frame {:.3}",
+            ph(&t.phantoms, f),
+            f64::from(t.wrong_class) / f
+        );
+        if t.det_frames > 0 {
+            let _ = writeln!(
+                s,
+                "  phantoms/frame among detections {}",
+                ph(&t.det_phantoms, f64::from(t.det_frames))
+            );
+        }
+        let _ = writeln!(
+            s,
+            "  identity: IDF1 {} ({} true of {} truth / {} reported), ID switches {}",
+            pct(t.idf1()),
+            t.idtp,
+            t.id_gt,
+            t.id_hyp,
+            t.id_switches
+        );
+        let within2 = t.move_gone_s.iter().filter(|&&x| x <= 2.0).count();
+        let _ = writeln!(
+            s,
+            "  moved pieces: {} seen empty; gone within 2 s {}, later {}, still on the map {}, never seen empty {}",
+            t.move_gone_s.len() + t.move_stuck as usize,
+            within2,
+            t.move_gone_s.len() - within2,
+            t.move_stuck,
+            t.move_unseen
+        );
+        let _ = writeln!(
+            s,
+            "  walking people: {} reports as furniture over {} frames with a person{}",
+            t.people_as_furniture,
+            t.people_frames,
+            if t.people_found[0] > 0 {
+                format!(
+                    "; `people` found {}/{}",
+                    t.people_found[1], t.people_found[0]
+                )
+            } else {
+                String::new()
+            }
+        );
+    }
+    s
+}

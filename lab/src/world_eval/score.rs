@@ -1,0 +1,629 @@
+//! Scoring `umbra`'s output lines against a run's truth: the final map (per-class precision
+//! and recall over the furniture that was visible), phantoms per frame by source, identity
+//! over time (IDF1 and ID switches, CLEAR-MOT sense), moved pieces leaving the map, doors,
+//! and walking people reported as furniture.
+
+use perception::class::ObjectClass;
+use perception::geometry::Point2;
+use serde_json::Value;
+
+use super::truth::{Furniture, RunTruth};
+
+/// A reported object is on a piece of furniture when within this distance of its footprint.
+pub const MATCH_M: f32 = 0.3;
+/// A reported door (or door frame) is on a doorway when within this distance of its centre.
+pub const DOOR_MATCH_M: f32 = 0.5;
+/// A reported object is on a walking person when within this distance of the legs' midpoint.
+pub const PERSON_M: f32 = 0.4;
+
+/// One reported object.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Reported {
+    /// `id`.
+    pub id: u64,
+    /// Class (None: a class this scorer does not know).
+    pub class: Option<ObjectClass>,
+    /// Position, map frame.
+    pub at: Point2,
+    /// `source`: 0 = A, 1 = B, 2 = AB.
+    pub source: usize,
+}
+
+/// One output line, as far as the scorer reads it.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct Line {
+    /// Sensor time, s.
+    pub t: f64,
+    /// `objects`.
+    pub objects: Vec<Reported>,
+    /// `doors` centres.
+    pub doors: Vec<Point2>,
+    /// `detections`, when the line has them.
+    pub detections: Option<Vec<Reported>>,
+    /// `people` positions, when the line has them.
+    pub people: Option<Vec<Point2>>,
+}
+
+fn objects(v: Option<&Value>) -> Option<Vec<Reported>> {
+    let arr = v?.as_array()?;
+    Some(
+        arr.iter()
+            .filter_map(|o| {
+                let x = o.get("x")?.as_f64()? as f32;
+                let y = o.get("y")?.as_f64()? as f32;
+                Some(Reported {
+                    id: o.get("id").and_then(Value::as_u64).unwrap_or(u64::MAX),
+                    class: o
+                        .get("class")
+                        .and_then(Value::as_str)
+                        .and_then(ObjectClass::from_name),
+                    at: Point2::new(x, y),
+                    source: match o.get("source").and_then(Value::as_str) {
+                        Some("A") => 0,
+                        Some("B") => 1,
+                        _ => 2,
+                    },
+                })
+            })
+            .collect(),
+    )
+}
+
+fn points(v: Option<&Value>) -> Option<Vec<Point2>> {
+    Some(
+        v?.as_array()?
+            .iter()
+            .filter_map(|o| {
+                Some(Point2::new(
+                    o.get("x")?.as_f64()? as f32,
+                    o.get("y")?.as_f64()? as f32,
+                ))
+            })
+            .collect(),
+    )
+}
+
+impl Line {
+    /// Parses one JSON output line (None: not a frame line).
+    pub fn parse(s: &str) -> Option<Line> {
+        let v: Value = serde_json::from_str(s).ok()?;
+        Some(Line {
+            t: v.get("t")?.as_f64()?,
+            objects: objects(v.get("objects"))?,
+            doors: points(v.get("doors")).unwrap_or_default(),
+            detections: objects(v.get("detections")),
+            people: points(v.get("people")),
+        })
+    }
+}
+
+/// Counts, summed over runs; the rates are derived when reporting.
+#[derive(Debug, Clone, Default, PartialEq, serde::Serialize)]
+pub struct Tally {
+    /// Runs.
+    pub runs: u32,
+    /// Frames scored.
+    pub frames: u32,
+    /// Final map, per class (chair, box, desk): matched visible furniture.
+    pub map_tp: [u32; 3],
+    /// Final map: reported objects of the class (not counting ones on unseen furniture).
+    pub map_reported: [u32; 3],
+    /// Final map: visible furniture of the class.
+    pub map_visible: [u32; 3],
+    /// Final map recall split: (found, visible) against a wall, and in the open.
+    pub wall_found: [u32; 2],
+    /// See `wall_found`.
+    pub open_found: [u32; 2],
+    /// Final `doors`: matched visible doors, reported doors, visible doors.
+    pub doors: [u32; 3],
+    /// Final `objects` of class door_frame on a visible door: doors found that way.
+    pub door_frames_found: u32,
+    /// Reported objects per frame that lie on no furniture and no door, by source A, B, AB.
+    pub phantoms: [u32; 3],
+    /// Reported objects on furniture of another class (and none of their own within reach).
+    pub wrong_class: u32,
+    /// Frames with a `detections` list, and the phantoms among those detections by source.
+    pub det_frames: u32,
+    /// See `det_frames`.
+    pub det_phantoms: [u32; 3],
+    /// IDF1's parts: ground-truth detections, reported detections, identity-true positives.
+    pub id_gt: u32,
+    /// See `id_gt`.
+    pub id_hyp: u32,
+    /// See `id_gt`.
+    pub idtp: u32,
+    /// Identity switches (CLEAR-MOT).
+    pub id_switches: u32,
+    /// Moves: seen empty and gone, seconds from seeing the place empty to its last report.
+    pub move_gone_s: Vec<f64>,
+    /// Moves seen empty whose old place was still reported at the end.
+    pub move_stuck: u32,
+    /// Moves whose old place the LiDAR never saw empty.
+    pub move_unseen: u32,
+    /// Object reports on a walking person (and on no furniture), and frames with a person.
+    pub people_as_furniture: u32,
+    /// See `people_as_furniture`.
+    pub people_frames: u32,
+    /// Frames × people in view of a `people` list, and how many it had within reach.
+    pub people_found: [u32; 2],
+}
+
+fn class_index(c: ObjectClass) -> Option<usize> {
+    match c {
+        ObjectClass::Chair => Some(0),
+        ObjectClass::Box => Some(1),
+        ObjectClass::Desk => Some(2),
+        ObjectClass::DoorFrame => None,
+    }
+}
+
+/// Class names of the tally's per-class arrays.
+pub const CLASSES: [&str; 3] = ["chair", "box", "desk"];
+
+fn on_furniture<'a>(
+    alive: &'a [&'a Furniture],
+    p: Point2,
+) -> impl Iterator<Item = &'a &'a Furniture> + 'a {
+    alive.iter().filter(move |f| f.distance(p) <= MATCH_M)
+}
+
+/// Optimal one-to-one assignment maximising total weight (Hungarian, via `pathfinding`).
+pub fn max_assignment(w: &[Vec<i64>]) -> i64 {
+    let rows = w.len();
+    let cols = w.iter().map(Vec::len).max().unwrap_or(0);
+    let n = rows.max(cols);
+    if n == 0 {
+        return 0;
+    }
+    let mut m = pathfinding::matrix::Matrix::new(n, n, 0i64);
+    for (i, r) in w.iter().enumerate() {
+        for (j, &x) in r.iter().enumerate() {
+            m[(i, j)] = x;
+        }
+    }
+    pathfinding::kuhn_munkres::kuhn_munkres(&m).0
+}
+
+/// Scores one run's lines into `tally`.
+pub fn score_run(truth: &RunTruth, lines: &[Line], tally: &mut Tally) {
+    tally.runs += 1;
+    let n_f = truth.furniture.len();
+    let mut hyp_ids: Vec<u64> = Vec::new();
+    let mut co: Vec<Vec<i64>> = vec![Vec::new(); n_f];
+    let mut last_match: Vec<Option<u64>> = vec![None; n_f];
+    for line in lines {
+        let Some(fi) = truth.frame_at(line.t) else {
+            continue;
+        };
+        tally.frames += 1;
+        let alive: Vec<&Furniture> = truth.furniture.iter().filter(|f| f.alive(fi)).collect();
+        let people = &truth.frames[fi].people;
+        if !people.is_empty() {
+            tally.people_frames += 1;
+        }
+        let mut tally_objects = |objs: &[Reported], phantoms: &mut [u32; 3], main: bool| {
+            for o in objs {
+                match o.class {
+                    Some(ObjectClass::DoorFrame) => {
+                        if !truth
+                            .doors
+                            .iter()
+                            .any(|d| d.centre.distance(o.at) <= DOOR_MATCH_M)
+                        {
+                            phantoms[o.source] += 1;
+                        }
+                    }
+                    c => {
+                        let mut near = on_furniture(&alive, o.at).peekable();
+                        if near.peek().is_none() {
+                            phantoms[o.source] += 1;
+                            if main && people.iter().any(|p| p.at.distance(o.at) <= PERSON_M) {
+                                tally.people_as_furniture += 1;
+                            }
+                        } else if main && !near.any(|f| Some(f.class) == c) {
+                            tally.wrong_class += 1;
+                        }
+                    }
+                }
+            }
+        };
+        let mut ph = tally.phantoms;
+        tally_objects(&line.objects, &mut ph, true);
+        tally.phantoms = ph;
+        if let Some(det) = &line.detections {
+            tally.det_frames += 1;
+            let mut ph = tally.det_phantoms;
+            tally_objects(det, &mut ph, false);
+            tally.det_phantoms = ph;
+        }
+        if let Some(found) = &line.people {
+            tally.people_found[0] += people.len() as u32;
+            tally.people_found[1] += people
+                .iter()
+                .filter(|p| found.iter().any(|q| q.distance(p.at) <= PERSON_M))
+                .count() as u32;
+        }
+        // Identity: furniture alive and already visible vs reported furniture-class objects.
+        let gt: Vec<usize> = (0..n_f)
+            .filter(|&g| {
+                truth.furniture[g].alive(fi)
+                    && truth.furniture[g].visible_from.is_some_and(|v| v <= fi)
+            })
+            .collect();
+        let hyp: Vec<&Reported> = line
+            .objects
+            .iter()
+            .filter(|o| o.class.is_some_and(|c| c != ObjectClass::DoorFrame))
+            .collect();
+        tally.id_gt += gt.len() as u32;
+        tally.id_hyp += hyp.len() as u32;
+        let mut pairs = Vec::new();
+        for &g in &gt {
+            for h in &hyp {
+                let d = truth.furniture[g].distance(h.at);
+                if d <= MATCH_M {
+                    let j = match hyp_ids.iter().position(|&x| x == h.id) {
+                        Some(j) => j,
+                        None => {
+                            hyp_ids.push(h.id);
+                            hyp_ids.len() - 1
+                        }
+                    };
+                    if co[g].len() <= j {
+                        co[g].resize(j + 1, 0);
+                    }
+                    co[g][j] += 1;
+                    // Keeping last frame's match comes first (CLEAR-MOT), then nearest.
+                    let keep = last_match[g] == Some(h.id);
+                    pairs.push((!keep, d, g, h.id));
+                }
+            }
+        }
+        pairs.sort_by(|a, b| a.0.cmp(&b.0).then(a.1.total_cmp(&b.1)));
+        let (mut used_g, mut used_h) = (Vec::new(), Vec::new());
+        for (_, _, g, h) in pairs {
+            if used_g.contains(&g) || used_h.contains(&h) {
+                continue;
+            }
+            used_g.push(g);
+            used_h.push(h);
+            if last_match[g].is_some_and(|l| l != h) {
+                tally.id_switches += 1;
+            }
+            last_match[g] = Some(h);
+        }
+    }
+    tally.idtp += max_assignment(&co) as u32;
+
+    // Moves.
+    for mv in &truth.moves {
+        let old = &truth.furniture[mv.before];
+        let Some(seen) = mv.seen_empty else {
+            tally.move_unseen += 1;
+            continue;
+        };
+        let t_seen = truth.frames[seen].t;
+        let reported_there = |l: &Line| {
+            l.objects.iter().any(|o| {
+                o.class.is_some_and(|c| c != ObjectClass::DoorFrame)
+                    && old.distance(o.at) <= MATCH_M
+            })
+        };
+        match lines.iter().rposition(reported_there) {
+            Some(k) if k + 1 == lines.len() => tally.move_stuck += 1,
+            Some(k) => tally.move_gone_s.push((lines[k + 1].t - t_seen).max(0.0)),
+            None => tally.move_gone_s.push(0.0),
+        }
+    }
+
+    // Final map.
+    let Some(last) = lines.last() else {
+        return;
+    };
+    let Some(fi) = truth.frame_at(last.t) else {
+        return;
+    };
+    let alive: Vec<&Furniture> = truth.furniture.iter().filter(|f| f.alive(fi)).collect();
+    let visible = |f: &Furniture| f.visible_from.is_some();
+    let mut taken = vec![false; alive.len()];
+    let mut order: Vec<(f32, usize, usize)> = Vec::new();
+    for (r, o) in last.objects.iter().enumerate() {
+        for (g, f) in alive.iter().enumerate() {
+            if o.class == Some(f.class) {
+                let d = f.distance(o.at);
+                if d <= MATCH_M {
+                    order.push((d, r, g));
+                }
+            }
+        }
+    }
+    order.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let mut report_matched = vec![None; last.objects.len()];
+    for (_, r, g) in order {
+        if report_matched[r].is_none() && !taken[g] {
+            taken[g] = true;
+            report_matched[r] = Some(g);
+        }
+    }
+    for (r, o) in last.objects.iter().enumerate() {
+        let Some(ci) = o.class.and_then(class_index) else {
+            continue;
+        };
+        match report_matched[r] {
+            Some(g) if !visible(alive[g]) => {} // on furniture too little seen to score
+            Some(_) => {
+                tally.map_reported[ci] += 1;
+                tally.map_tp[ci] += 1;
+            }
+            None => tally.map_reported[ci] += 1,
+        }
+    }
+    for (g, f) in alive.iter().enumerate() {
+        if !visible(f) {
+            continue;
+        }
+        if let Some(ci) = class_index(f.class) {
+            tally.map_visible[ci] += 1;
+        }
+        let split = if f.against_wall {
+            &mut tally.wall_found
+        } else {
+            &mut tally.open_found
+        };
+        split[1] += 1;
+        split[0] += u32::from(taken[g]);
+    }
+    // Doors.
+    let seen_doors: Vec<_> = truth
+        .doors
+        .iter()
+        .filter(|d| d.returns >= super::truth::VISIBLE_RETURNS)
+        .collect();
+    tally.doors[2] += seen_doors.len() as u32;
+    tally.doors[1] += last.doors.len() as u32;
+    let mut door_taken = vec![false; truth.doors.len()];
+    for d in &last.doors {
+        if let Some(k) = truth
+            .doors
+            .iter()
+            .enumerate()
+            .position(|(k, t)| !door_taken[k] && t.centre.distance(*d) <= DOOR_MATCH_M)
+        {
+            door_taken[k] = true;
+            if truth.doors[k].returns >= super::truth::VISIBLE_RETURNS {
+                tally.doors[0] += 1;
+            } else {
+                tally.doors[1] -= 1; // a door too little seen to score
+            }
+        }
+    }
+    tally.door_frames_found += seen_doors
+        .iter()
+        .filter(|t| {
+            last.objects.iter().any(|o| {
+                o.class == Some(ObjectClass::DoorFrame) && o.at.distance(t.centre) <= DOOR_MATCH_M
+            })
+        })
+        .count() as u32;
+}
+
+impl Tally {
+    /// Sums another tally into this one.
+    pub fn add(&mut self, o: &Tally) {
+        macro_rules! sum {
+            ($($f:ident),*) => { $( self.$f += o.$f; )* };
+        }
+        macro_rules! sum_arr {
+            ($($f:ident),*) => { $( for (a, b) in self.$f.iter_mut().zip(&o.$f) { *a += b; } )* };
+        }
+        sum!(
+            runs,
+            frames,
+            door_frames_found,
+            wrong_class,
+            det_frames,
+            id_gt,
+            id_hyp,
+            idtp
+        );
+        sum!(
+            id_switches,
+            move_stuck,
+            move_unseen,
+            people_as_furniture,
+            people_frames
+        );
+        sum_arr!(
+            map_tp,
+            map_reported,
+            map_visible,
+            wall_found,
+            open_found,
+            doors,
+            phantoms
+        );
+        sum_arr!(det_phantoms, people_found);
+        self.move_gone_s.extend_from_slice(&o.move_gone_s);
+    }
+
+    /// IDF1 = 2·IDTP / (GT + reported).
+    pub fn idf1(&self) -> f64 {
+        ratio(2 * self.idtp, self.id_gt + self.id_hyp)
+    }
+}
+
+/// `a / b`, NaN when `b` is 0.
+pub fn ratio(a: u32, b: u32) -> f64 {
+    if b == 0 {
+        f64::NAN
+    } else {
+        f64::from(a) / f64::from(b)
+    }
+}
+
+#[cfg(test)]
+mod test {
+    use super::super::truth::{Door, FrameTruth, Move};
+    use super::*;
+
+    fn square(c: Point2, h: f32) -> Vec<Point2> {
+        vec![
+            Point2::new(c.x - h, c.y - h),
+            Point2::new(c.x + h, c.y - h),
+            Point2::new(c.x + h, c.y + h),
+            Point2::new(c.x - h, c.y + h),
+        ]
+    }
+
+    fn truth() -> RunTruth {
+        let f = |piece, class, x, y| Furniture {
+            piece,
+            class,
+            footprint: square(Point2::new(x, y), 0.2),
+            from_frame: 0,
+            to_frame: usize::MAX,
+            visible_from: Some(0),
+            returns: 100,
+            what: String::new(),
+            against_wall: false,
+        };
+        RunTruth {
+            name: "t".into(),
+            furniture: vec![
+                f(0, ObjectClass::Chair, 1.0, 0.0),
+                f(1, ObjectClass::Box, -1.0, 0.0),
+            ],
+            doors: vec![Door {
+                centre: Point2::new(0.0, 2.0),
+                width: 0.9,
+                returns: 50,
+            }],
+            clutter: vec![],
+            frames: (0..4)
+                .map(|k| FrameTruth {
+                    t: 0.2 * f64::from(k),
+                    people: vec![],
+                })
+                .collect(),
+            moves: vec![],
+        }
+    }
+
+    fn obj(id: u64, class: ObjectClass, x: f32, y: f32) -> Reported {
+        Reported {
+            id,
+            class: Some(class),
+            at: Point2::new(x, y),
+            source: 2,
+        }
+    }
+
+    #[test]
+    fn perfect_lines_score_perfectly() {
+        let t = truth();
+        let lines: Vec<Line> = (0..4)
+            .map(|k| Line {
+                t: 0.2 * f64::from(k),
+                objects: vec![
+                    obj(7, ObjectClass::Chair, 1.0, 0.05),
+                    obj(9, ObjectClass::Box, -1.1, 0.0),
+                ],
+                doors: vec![Point2::new(0.1, 2.0)],
+                ..Line::default()
+            })
+            .collect();
+        let mut s = Tally::default();
+        score_run(&t, &lines, &mut s);
+        assert_eq!(s.map_tp, [1, 1, 0]);
+        assert_eq!(s.map_reported, [1, 1, 0]);
+        assert_eq!(s.map_visible, [1, 1, 0]);
+        assert_eq!(s.doors, [1, 1, 1]);
+        assert_eq!(s.phantoms, [0, 0, 0]);
+        assert_eq!((s.id_switches, s.idtp, s.id_gt, s.id_hyp), (0, 8, 8, 8));
+        assert!((s.idf1() - 1.0).abs() < 1e-9);
+    }
+
+    #[test]
+    fn ids_that_trade_places_switch_and_lower_idf1() {
+        let t = truth();
+        // Ids are list positions, and the list order flips after two frames.
+        let lines: Vec<Line> = (0..4)
+            .map(|k| {
+                let mut objects = vec![
+                    obj(0, ObjectClass::Chair, 1.0, 0.0),
+                    obj(1, ObjectClass::Box, -1.0, 0.0),
+                ];
+                if k >= 2 {
+                    objects.reverse();
+                    objects[0].id = 0;
+                    objects[1].id = 1;
+                }
+                Line {
+                    t: 0.2 * f64::from(k),
+                    objects,
+                    ..Line::default()
+                }
+            })
+            .collect();
+        let mut s = Tally::default();
+        score_run(&t, &lines, &mut s);
+        assert_eq!(s.id_switches, 2);
+        assert_eq!(s.idtp, 4);
+        assert!((s.idf1() - 0.5).abs() < 1e-9);
+    }
+
+    #[test]
+    fn phantoms_wrong_classes_and_a_stuck_move_are_counted() {
+        let mut t = truth();
+        t.moves.push(Move {
+            before: 1,
+            frame: 1,
+            seen_empty: Some(2),
+        });
+        t.furniture[1].to_frame = 1;
+        let lines: Vec<Line> = (0..4)
+            .map(|k| Line {
+                t: 0.2 * f64::from(k),
+                objects: vec![
+                    Reported {
+                        source: 0,
+                        ..obj(3, ObjectClass::Desk, 1.0, 0.0)
+                    },
+                    Reported {
+                        source: 1,
+                        ..obj(4, ObjectClass::Box, 3.0, 3.0)
+                    },
+                    obj(5, ObjectClass::Box, -1.0, 0.0),
+                ],
+                ..Line::default()
+            })
+            .collect();
+        let mut s = Tally::default();
+        score_run(&t, &lines, &mut s);
+        // The box at (3, 3) is a phantom in every frame; the one at the moved box's old place
+        // is one from frame 1 on.
+        assert_eq!(s.phantoms, [0, 4, 3]);
+        assert_eq!(s.wrong_class, 4);
+        assert_eq!(s.move_stuck, 1);
+        assert_eq!(s.map_tp, [0, 0, 0]);
+        assert_eq!(s.map_visible, [1, 0, 0]);
+        assert_eq!(s.map_reported, [0, 2, 1]);
+    }
+
+    #[test]
+    fn line_parsing_reads_the_contract() {
+        let l = Line::parse(r#"{"frame":3,"t":0.6,"pose":{"x":0,"y":0,"theta":0},"objects":[{"id":4,"class":"chair","x":1.0,"y":2.0,"score":0.9,"source":"B"}],"doors":[{"x":0.5,"y":0.1,"width":0.9}],"walls":[]}"#).unwrap();
+        assert_eq!(
+            l.objects,
+            vec![Reported {
+                id: 4,
+                class: Some(ObjectClass::Chair),
+                at: Point2::new(1.0, 2.0),
+                source: 1
+            }]
+        );
+        assert_eq!(l.doors, vec![Point2::new(0.5, 0.1)]);
+        assert!(l.detections.is_none());
+        assert!(Line::parse("umbra: done").is_none());
+    }
+}
