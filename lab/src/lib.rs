@@ -10,6 +10,7 @@
 //! | [`scenes_a`]      | Method A run on simulated scenes, with truth labels for training and scoring |
 //! | [`eval_a`]        | Method A scored against the simulator's truth; forest training rows |
 //! | [`eval_b`]        | Method B scored on a dataset split: P, R, mAP50, mAP50-95 as Ultralytics does |
+//! | [`canvas`]        | an RGB canvas with a built-in font, written as PNG (the figures)   |
 //! | [`confusion_png`] | the evaluation's confusion matrix as a PNG                        |
 //! | [`pose_eval`]     | drift of odometry, compass overwrite and our fusion on the simulator |
 //! | [`world_eval`]    | `eval-world`: `umbra replay`'s world scored on two scene families |
@@ -17,6 +18,7 @@
 #![deny(unsafe_code, missing_docs)]
 
 pub mod annex;
+pub mod canvas;
 pub mod confusion_png;
 pub mod eval_a;
 pub mod eval_b;

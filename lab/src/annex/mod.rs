@@ -294,6 +294,17 @@ pub fn generate(seed: u64, seconds: f64, tour: bool, lidar: LidarModel) -> Gener
             })
             .into_iter()
             .collect(),
+        walls: plan
+            .fixed
+            .iter()
+            .filter_map(|p| match (p.owner, p.shape) {
+                (
+                    Owner::Wall | Owner::Jamb(_) | Owner::Leaf,
+                    sim::world::Shape::Segment { a, b },
+                ) => Some((to_map.transform(a), to_map.transform(b))),
+                _ => None,
+            })
+            .collect(),
     };
     GeneratedRun {
         capture,

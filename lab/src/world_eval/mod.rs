@@ -6,6 +6,7 @@
 //! through the `umbra` binary itself (`umbra replay CAPTURE --odom TICKS --jsonl -`), with the
 //! world model on or off; the output lines are scored by [`score`].
 
+pub mod picture;
 pub mod score;
 pub mod sim_family;
 pub mod truth;
@@ -170,6 +171,14 @@ pub fn evaluate(cfg: &EvalConfig, mut progress: impl FnMut(&str)) -> Result<Vec<
                 .map_err(|e| e.to_string())?;
             for o in &mut per {
                 let lines = replay(&cfg.umbra, &dir, &run, o.world)?;
+                let on = if o.world { "on" } else { "off" };
+                picture::write(
+                    &dir.join(format!("map-world-{on}.png")),
+                    &format!("{} - world model {on}", run.truth.name),
+                    &run.truth,
+                    &lines,
+                )
+                .map_err(|e| e.to_string())?;
                 let mut t = Tally::default();
                 score_run(&run.truth, &lines, &mut t);
                 o.tally.add(&t);

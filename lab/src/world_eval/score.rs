@@ -42,6 +42,8 @@ pub struct Line {
     pub detections: Option<Vec<Reported>>,
     /// `people` positions, when the line has them.
     pub people: Option<Vec<Point2>>,
+    /// The robot's position.
+    pub pose: Option<Point2>,
 }
 
 fn objects(v: Option<&Value>) -> Option<Vec<Reported>> {
@@ -93,6 +95,12 @@ impl Line {
             doors: points(v.get("doors")).unwrap_or_default(),
             detections: objects(v.get("detections")),
             people: points(v.get("people")),
+            pose: v.get("pose").and_then(|p| {
+                Some(Point2::new(
+                    p.get("x")?.as_f64()? as f32,
+                    p.get("y")?.as_f64()? as f32,
+                ))
+            }),
         })
     }
 }
@@ -506,6 +514,7 @@ mod test {
                 })
                 .collect(),
             moves: vec![],
+            walls: vec![],
         }
     }
 

@@ -104,6 +104,16 @@ pub fn generate(seed: u64, i: usize, seconds: f64) -> GeneratedRun {
             .collect::<Vec<(Point2, String)>>(),
         frames,
         moves: Vec::new(),
+        walls: w
+            .prims
+            .iter()
+            .filter_map(|p| match (p.surface, p.shape) {
+                (Surface::Wall | Surface::DoorFrame(_), sim::world::Shape::Segment { a, b }) => {
+                    Some((to_map.transform(a), to_map.transform(b)))
+                }
+                _ => None,
+            })
+            .collect(),
     };
     GeneratedRun {
         capture,

@@ -110,6 +110,8 @@ pub struct RunTruth {
     pub frames: Vec<FrameTruth>,
     /// Moves.
     pub moves: Vec<Move>,
+    /// Wall, jamb and door-leaf faces (for pictures).
+    pub walls: Vec<(Point2, Point2)>,
 }
 
 impl RunTruth {
