@@ -53,6 +53,9 @@ pub struct FrameObject {
     pub evidence: Evidence,
     /// Method B's box `[cx, cy, w, h]` in pixels of the 384 × 64 input (B and AB only).
     pub bbox: Option<[f32; 4]>,
+    /// Width across, m, where known (a door's clear width: Method A's, or from Method B's
+    /// box); 0 = unknown.
+    pub width_m: f32,
 }
 
 /// A Method B box placed in the map.
@@ -66,6 +69,14 @@ pub struct PlacedBox {
     pub score: f32,
     /// `[cx, cy, w, h]`, px.
     pub bbox: [f32; 4],
+    /// Width across in the map, m (the box's bearing span at its range; 0 = unknown).
+    pub width_m: f32,
+}
+
+/// Width in metres across a box `w_deg` degrees wide at `range_m` (one raster column is one
+/// degree of bearing).
+pub fn width_across(w_deg: f32, range_m: f32) -> f32 {
+    2.0 * range_m * libm::tanf((w_deg * 0.5).clamp(0.0, 80.0).to_radians())
 }
 
 /// The frame's objects, in output order.
@@ -80,6 +91,7 @@ pub fn push_a(objects: &mut FrameObjects, class: ObjectClass, centre: Point2, sc
             score,
             evidence: Evidence::A,
             bbox: None,
+            width_m: 0.0,
         })
         .is_ok()
 }
@@ -104,6 +116,9 @@ pub fn merge_b(objects: &mut FrameObjects, b: &PlacedBox) -> bool {
             o.evidence = Evidence::AB;
             o.score = o.score.max(b.score);
             o.bbox = Some(b.bbox);
+            if o.width_m <= 0.0 {
+                o.width_m = b.width_m;
+            }
             true
         }
         None => objects
@@ -113,6 +128,7 @@ pub fn merge_b(objects: &mut FrameObjects, b: &PlacedBox) -> bool {
                 score: b.score,
                 evidence: Evidence::B,
                 bbox: Some(b.bbox),
+                width_m: b.width_m,
             })
             .is_ok(),
     }
@@ -128,6 +144,7 @@ mod test {
             centre: Point2::new(x, y),
             score,
             bbox: [10.0, 20.0, 4.0, 6.0],
+            width_m: 0.0,
         }
     }
 

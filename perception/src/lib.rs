@@ -19,6 +19,7 @@
 //! | [`features`]   | the 9-D feature vector, in the object's frame or the map's |
 //! | [`method_a`]   | the geometric pipeline end to end, classifier as a parameter |
 //! | [`yolo`]       | Method B's output: YOLOv8 decode, suppression, map-frame centres |
+//! | [`plausible`]  | furniture that cannot be: centres in or behind a wall seen this revolution |
 //! | [`fusion`]     | one frame's objects from both methods: A's, and B's joined or added |
 //! | [`tracks`]     | the world model's tracks: stable ids, association, evidence, negative evidence |
 //!
@@ -36,6 +37,7 @@ pub mod fusion;
 pub mod geometry;
 pub mod merge;
 pub mod method_a;
+pub mod plausible;
 pub mod pose;
 pub mod raster;
 pub mod shape;

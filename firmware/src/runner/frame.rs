@@ -6,10 +6,12 @@
 use std::io;
 use std::time::{Duration, Instant};
 
+use perception::class::ObjectClass;
 use perception::cloud::Scan;
-use perception::fusion::{FrameObjects, merge_b, push_a};
+use perception::fusion::{Evidence, FrameObjects, merge_b, push_a};
 use perception::geometry::{Point2, Pose2};
 use perception::method_a::{MethodA, MethodAConfig};
+use perception::plausible::drop_walled;
 use perception::tracks::Tracks;
 
 use super::FrameLoop;
@@ -24,6 +26,16 @@ use crate::record_format::RECORD_RAW_BYTES;
 use crate::sink::FrameView;
 use crate::source::{LidarSource, Pacing};
 use drivers::lidar::RevolutionStream;
+
+/// A Method B door frame this close to a door of Method A's is that door, m.
+const DOOR_SAME_M: f64 = 0.5;
+
+/// Adds a door unless the list is at its start-up capacity (the frame loop never grows it).
+fn push_door(doors: &mut Vec<DoorOut>, d: DoorOut) {
+    if doors.len() < doors.capacity() {
+        doors.push(d);
+    }
+}
 
 /// What the loop keeps between frames, allocated once at start-up.
 pub(super) struct FrameState {
@@ -56,6 +68,8 @@ pub(super) struct FrameState {
     detections: Vec<ObjectOut>,
     pub(super) walls: Vec<WallOut>,
     pub(super) doors: Vec<DoorOut>,
+    /// Detections dropped for lying in or behind a wall (`perception::plausible`).
+    pub(super) walled: u64,
     /// While recording: the LiDAR bytes read since the recorder last took them.
     recording: Option<RecordingInput>,
 }
@@ -89,7 +103,10 @@ impl FrameState {
             objects: Vec::with_capacity(perception::tracks::MAX_TRACKS),
             detections: Vec::with_capacity(perception::fusion::MAX_FRAME_OBJECTS),
             walls: Vec::with_capacity(perception::walls::MAX_SEGMENTS),
-            doors: Vec::with_capacity(perception::doors::MAX_DOORS),
+            doors: Vec::with_capacity(
+                perception::doors::MAX_DOORS + perception::tracks::MAX_TRACKS,
+            ),
+            walled: 0,
             recording: recording.then(|| RecordingInput {
                 raw: Box::new(heapless::Vec::new()),
                 dropped: 0,
@@ -171,12 +188,11 @@ impl FrameState {
                 width: f64::from(d.width),
                 score: f64::from(d.score),
             });
-            push_a(
-                &mut self.fused,
-                perception::class::ObjectClass::DoorFrame,
-                d.centre,
-                d.score,
-            );
+            if push_a(&mut self.fused, ObjectClass::DoorFrame, d.centre, d.score)
+                && let Some(o) = self.fused.last_mut()
+            {
+                o.width_m = d.width;
+            }
         }
     }
 
@@ -285,6 +301,15 @@ impl<S: RevolutionStream> FrameLoop<'_, S> {
             (None, Some(b)) => b.mount,
             (None, None) => Pose2::IDENTITY,
         };
+        // Furniture in or behind a wall this revolution showed is not furniture.
+        if let Some((_, m)) = &opts.method_a {
+            let sensor = pose.end.compose(m);
+            st.walled += u64::from(drop_walled(
+                &mut st.fused,
+                Point2::new(sensor.x, sensor.y),
+                st.method_a.segments(),
+            ));
+        }
         st.detections.clear();
         for (id, o) in st.fused.iter().enumerate() {
             st.detections.push(ObjectOut::new(id, o));
@@ -296,6 +321,45 @@ impl<S: RevolutionStream> FrameLoop<'_, S> {
                 .update(frame, &st.fused, &lidar, st.history.newest(), cfg);
             for t in st.tracks.confirmed() {
                 st.objects.push(ObjectOut::track(t));
+            }
+            // Doors are map entries like objects: the confirmed door-frame tracks, whichever
+            // method found them.
+            st.doors.clear();
+            for t in st.tracks.confirmed() {
+                if t.class() == ObjectClass::DoorFrame && t.width_m > 0.0 {
+                    let o = ObjectOut::track(t);
+                    push_door(
+                        &mut st.doors,
+                        DoorOut {
+                            x: o.x,
+                            y: o.y,
+                            width: f64::from(t.width_m),
+                            score: o.score,
+                        },
+                    );
+                }
+            }
+        } else {
+            // Door frames Method B found where Method A found none are doors too.
+            for o in st.fused.iter().filter(|o| {
+                o.class == ObjectClass::DoorFrame && o.evidence == Evidence::B && o.width_m > 0.0
+            }) {
+                let (x, y) = (f64::from(o.centre.x), f64::from(o.centre.y));
+                if st
+                    .doors
+                    .iter()
+                    .all(|d| (d.x - x).hypot(d.y - y) > DOOR_SAME_M)
+                {
+                    push_door(
+                        &mut st.doors,
+                        DoorOut {
+                            x,
+                            y,
+                            width: f64::from(o.width_m),
+                            score: f64::from(o.score),
+                        },
+                    );
+                }
             }
         }
 

@@ -84,11 +84,14 @@ impl MethodBSetup {
         }
         let lidar = middle.compose(&self.mount);
         for d in scratch.detections.iter() {
+            let centre = d.centre(&lidar, &self.raster);
+            let range = centre.distance(perception::geometry::Point2::new(lidar.x, lidar.y));
             place(PlacedBox {
                 class: d.class,
-                centre: d.centre(&lidar, &self.raster),
+                centre,
                 score: d.score,
                 bbox: [d.cx, d.cy, d.w, d.h],
+                width_m: perception::fusion::width_across(d.w, range),
             });
         }
         Ok(())

@@ -249,6 +249,7 @@ impl<S: RevolutionStream> FrameLoop<'_, S> {
             }
         }
         s.deadlines = self.st.record.clone();
+        s.walled_detections = self.st.walled;
         s.budgets = Some(self.opts.budgets);
         s.power = PowerVerdict {
             mean_w: (self.st.power_n > 0).then(|| self.st.power_sum / self.st.power_n as f64),

@@ -33,6 +33,8 @@ pub struct Summary {
     pub power: PowerVerdict,
     /// Frames the recording / live view dropped (its thread was behind).
     pub viz_dropped: u64,
+    /// Detections dropped for lying in or behind a wall (`perception::plausible`).
+    pub walled_detections: u64,
 }
 
 impl Summary {

@@ -303,6 +303,15 @@ pub fn report(outcomes: &[Outcome]) -> String {
             ph(&t.phantoms, f),
             f64::from(t.wrong_class) / f
         );
+        let _ = writeln!(
+            s,
+            "    of them within 0.15 m of a wall face {:.3}/frame; by class chair {:.3}, box {:.3}, desk {:.3}, door frame {:.3}",
+            f64::from(t.phantoms_at_wall) / f,
+            f64::from(t.phantoms_by_class[0]) / f,
+            f64::from(t.phantoms_by_class[1]) / f,
+            f64::from(t.phantoms_by_class[2]) / f,
+            f64::from(t.phantoms_by_class[3]) / f
+        );
         if t.det_frames > 0 {
             let _ = writeln!(
                 s,

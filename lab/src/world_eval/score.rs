@@ -128,6 +128,11 @@ pub struct Tally {
     pub door_frames_found: u32,
     /// Reported objects per frame that lie on no furniture and no door, by source A, B, AB.
     pub phantoms: [u32; 3],
+    /// Phantoms (among `objects`) within 0.15 m of a wall face, and by class (chair, box, desk,
+    /// door frame).
+    pub phantoms_at_wall: u32,
+    /// See `phantoms_at_wall`.
+    pub phantoms_by_class: [u32; 4],
     /// Reported objects on furniture of another class (and none of their own within reach).
     pub wrong_class: u32,
     /// Frames with a `detections` list, and the phantoms among those detections by source.
@@ -225,6 +230,16 @@ pub fn score_run(truth: &RunTruth, lines: &[Line], tally: &mut Tally) {
                         let mut near = on_furniture(&alive, o.at).peekable();
                         if near.peek().is_none() {
                             phantoms[o.source] += 1;
+                            if main {
+                                let at_wall = truth
+                                    .walls
+                                    .iter()
+                                    .any(|(a, b)| o.at.distance_to_segment(*a, *b) <= 0.15);
+                                tally.phantoms_at_wall += u32::from(at_wall);
+                                if let Some(c) = c {
+                                    tally.phantoms_by_class[c as usize] += 1;
+                                }
+                            }
                             if main && people.iter().any(|p| p.at.distance(o.at) <= PERSON_M) {
                                 tally.people_as_furniture += 1;
                             }
@@ -450,7 +465,7 @@ impl Tally {
             doors,
             phantoms
         );
-        sum_arr!(det_phantoms, people_found);
+        sum_arr!(det_phantoms, people_found, phantoms_by_class);
         self.move_gone_s.extend_from_slice(&o.move_gone_s);
     }
 

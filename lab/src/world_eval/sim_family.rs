@@ -84,7 +84,11 @@ pub fn generate(seed: u64, i: usize, seconds: f64) -> GeneratedRun {
                 visible_from: visible_from[k],
                 returns: returns[k],
                 what: o.class.as_str().into(),
-                against_wall: w.clearance(o.centre) < 0.1 + o.footprint[0].distance(o.centre),
+                against_wall: o.footprint.iter().any(|&c| {
+                    w.prims
+                        .iter()
+                        .any(|p| p.surface == Surface::Wall && p.shape.distance(c) < 0.1)
+                }),
             })
             .collect(),
         doors: w
