@@ -20,8 +20,8 @@
 //!    evicted (counted).
 //! 5. **Confirmation and deletion:** a track is reported ([`Track::confirmed`]) once it has
 //!    [`TrackConfig::confirm_hits`] hits and existence above [`TrackConfig::confirm_existence`],
-//!    and, when only one method has seen it, [`TrackConfig::single_method_hits`] hits in at
-//!    least [`TrackConfig::single_method_rate`] of the frames it was in view;
+//!    and, unless both methods agreed on it in one frame, [`TrackConfig::single_method_hits`]
+//!    hits in at least [`TrackConfig::single_method_rate`] of the frames it was in view;
 //!    it is deleted when existence falls below [`TrackConfig::delete_existence`], or when a
 //!    tentative track goes unseen for [`TrackConfig::tentative_frames`]. A track out of view
 //!    keeps its state: an object behind the robot is still in the room.
@@ -126,6 +126,8 @@ pub struct Track {
     /// Seen by Method A / by Method B so far.
     seen_a: bool,
     seen_b: bool,
+    /// Both methods saw it in one frame (an AB observation): the strongest evidence there is.
+    agreed: bool,
     /// Reported.
     pub confirmed: bool,
     /// Width across, m (door frames: the clear width, a running mean of the observations
@@ -170,12 +172,12 @@ impl Track {
     }
 }
 
-/// Whether a track has the evidence to be reported: enough hits and existence, and when only
-/// one method has seen it, more hits and a steady detection rate while in view.
+/// Whether a track has the evidence to be reported: enough hits and existence, and unless
+/// both methods agreed on it in one frame, more hits and a steady detection rate while in
+/// view (Method A seeing it once and Method B once, in different frames, is not agreement).
 fn earns_report(t: &Track, cfg: &TrackConfig) -> bool {
     let base = t.hits >= cfg.confirm_hits && t.existence >= cfg.confirm_existence;
-    let both = t.seen_a && t.seen_b;
-    base && (both
+    base && (t.agreed
         || (t.hits >= cfg.single_method_hits
             && t.hits as f32 >= cfg.single_method_rate * t.views as f32))
 }
@@ -398,6 +400,7 @@ impl Tracks {
                 last_seen: frame,
                 seen_a: false,
                 seen_b: false,
+                agreed: false,
                 confirmed: false,
                 width_m: 0.0,
             };
@@ -435,6 +438,7 @@ impl Tracks {
             Evidence::AB => {
                 t.seen_a = true;
                 t.seen_b = true;
+                t.agreed = true;
             }
         }
         if earns_report(t, cfg) {
@@ -480,6 +484,7 @@ impl Tracks {
                 t.last_seen = t.last_seen.max(gone.last_seen);
                 t.seen_a |= gone.seen_a;
                 t.seen_b |= gone.seen_b;
+                t.agreed |= gone.agreed;
                 t.confirmed |= gone.confirmed;
                 if t.width_m <= 0.0 {
                     t.width_m = gone.width_m;

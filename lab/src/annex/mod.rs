@@ -313,3 +313,52 @@ pub fn generate(seed: u64, seconds: f64, tour: bool, lidar: LidarModel) -> Gener
         truth,
     }
 }
+
+#[cfg(test)]
+mod test {
+    use super::*;
+    use drivers::lds01::{Lds01Config, Lds01Stream};
+    use drivers::lidar::RevolutionStream as _;
+
+    #[test]
+    fn same_seed_same_run_and_the_driver_reads_every_revolution() {
+        let a = generate(7, 4.0, true, LidarModel::Lds01);
+        let b = generate(7, 4.0, true, LidarModel::Lds01);
+        assert_eq!(a.capture, b.capture);
+        assert_eq!(a.odom, b.odom);
+        assert_eq!(a.truth, b.truth);
+        assert_eq!(a.capture.len(), 20 * 2520);
+        let mut stream = Lds01Stream::new(Lds01Config::default());
+        let mut revs = 0;
+        stream.feed(&a.capture, None, |r| {
+            assert!(r.is_complete());
+            revs += 1;
+        });
+        assert_eq!(revs, 20);
+        let f = stream.faults();
+        assert_eq!(
+            (f.bytes_skipped, f.bad_checksum, f.missing_packets),
+            (0, 0, 0)
+        );
+        // 25 Hz ticks over 4 s.
+        assert!(
+            (99..=102).contains(&a.odom.lines().count()),
+            "{}",
+            a.odom.lines().count()
+        );
+    }
+
+    #[test]
+    fn runs_hold_furniture_doors_and_walls_and_seeds_differ() {
+        let runs: Vec<_> = (0..6u64)
+            .map(|s| generate(100 + s, 2.0, s % 2 == 1, LidarModel::Lds01))
+            .collect();
+        for r in &runs {
+            assert!(!r.truth.furniture.is_empty(), "{}", r.truth.name);
+            assert!(!r.truth.doors.is_empty(), "{}", r.truth.name);
+            assert!(r.truth.walls.len() >= 8, "{}", r.truth.name);
+            assert_eq!(r.truth.frames.len(), 10);
+        }
+        assert_ne!(runs[0].capture, runs[2].capture);
+    }
+}
