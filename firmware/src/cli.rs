@@ -114,9 +114,12 @@ pub struct Common {
     /// Method B's YOLO model (ONNX, 1×3×64×384 → 1×8×504); default: the compiled-in one.
     #[arg(long, value_name = "MODEL.onnx")]
     pub model: Option<PathBuf>,
-    /// No per-frame statistics lines.
+    /// No per-frame human-readable lines.
     #[arg(long, short)]
     pub quiet: bool,
+    /// Also print each revolution's LiDAR statistics (rpm, packets, valid readings, ranges).
+    #[arg(long, short)]
+    pub verbose: bool,
     /// Record the run to this MCAP file (Foxglove schemas: scan, transforms, pose, scene).
     #[arg(long, value_name = "PATH.mcap")]
     pub record: Option<PathBuf>,

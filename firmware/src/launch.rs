@@ -19,7 +19,7 @@ use crate::odom::{OdomFile, PoseInput, PoseState};
 use crate::power::PowerMeter;
 use crate::reader::open_compass;
 use crate::runner::{self, MethodBSetup, RunOptions, SecondsClock, Summary};
-use crate::sink::{FrameSink, JsonlSink, StatsSink};
+use crate::sink::{FrameSink, JsonlSink, SceneSink, StatsSink};
 use crate::source::{LidarSource, Pacing};
 
 /// `umbra run`: a LiDAR port, or the built-in simulated robot when none is named.
@@ -304,11 +304,16 @@ fn run_loop(
             |e| (EXIT_USAGE, format!("--jsonl {path}: cannot create: {e}")),
         )?))),
     };
-    let stats: Option<Box<dyn Write>> = match (common.quiet, jsonl_to_stdout) {
-        (true, _) => None,
-        (false, true) => Some(Box::new(std::io::stderr())),
-        (false, false) => Some(Box::new(std::io::stdout())),
+    // The human lines go to stdout, or to stderr when the JSON lines take stdout.
+    let human = || -> Option<Box<dyn Write>> {
+        match (common.quiet, jsonl_to_stdout) {
+            (true, _) => None,
+            (false, true) => Some(Box::new(std::io::stderr())),
+            (false, false) => Some(Box::new(std::io::stdout())),
+        }
     };
+    let scene = human();
+    let stats = if common.verbose { human() } else { None };
     let stop = Arc::new(AtomicBool::new(false));
     let flag = stop.clone();
     if let Err(e) = ctrlc::set_handler(move || flag.store(true, Ordering::Relaxed)) {
@@ -330,6 +335,9 @@ fn run_loop(
     let mut sinks: Vec<Box<dyn FrameSink>> = Vec::new();
     if let Some(w) = jsonl {
         sinks.push(Box::new(JsonlSink(w)));
+    }
+    if let Some(w) = scene {
+        sinks.push(Box::new(SceneSink(w)));
     }
     if let Some(w) = stats {
         sinks.push(Box::new(StatsSink(w)));
@@ -482,6 +490,12 @@ fn print_summary(s: &Summary) {
         s.link.1,
         s.deadlines.missed
     );
+    if s.walled_detections > 0 {
+        eprintln!(
+            "umbra: {} detections in or behind a wall dropped (not furniture)",
+            s.walled_detections
+        );
+    }
     if s.viz_dropped > 0 {
         eprintln!(
             "umbra: recording/live view dropped {} frames (its thread was behind)",

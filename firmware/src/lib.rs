@@ -13,6 +13,7 @@
 //! | [`carmen`]      | CARMEN logs as a revolution stream with their odometry               |
 //! | [`odom`]        | odometry/compass samples (`--odom`, devices, simulator, recordings) → pose |
 //! | [`runner`]      | the frame loop: ingest → pose → Method A → Method B → fusion → outputs |
+//! | [`scene_line`]  | the human-readable line: pose, objects by class with ids, doors, frame time |
 //! | [`sink`]        | where frames go: the `FrameSink` trait, JSON lines, statistics lines |
 //! | [`output`]      | the JSON output line (§3) and the per-revolution statistics line     |
 //! | [`deadline`]    | stage histograms, budgets, the overrun policy, the deadline table    |
@@ -46,6 +47,7 @@ pub mod record_format;
 pub mod recording;
 pub mod report;
 pub mod runner;
+pub mod scene_line;
 pub mod sink;
 pub mod snapshot;
 pub mod source;

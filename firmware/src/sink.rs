@@ -1,6 +1,7 @@
 //! Where a frame's results go: the [`FrameSink`] trait the frame loop hands every finished
-//! frame to, and the two sinks every build has — the JSON line of `docs/interfaces.md` §3
-//! ([`JsonlSink`]) and the human-readable per-revolution line ([`StatsSink`]). Recording and
+//! frame to, and the sinks every build has — the JSON line of `docs/interfaces.md` §3
+//! ([`JsonlSink`]), the human-readable line of what the robot sees ([`SceneSink`]) and the
+//! LiDAR's statistics line of `--verbose` ([`StatsSink`]). Recording and
 //! the live view (`crate::viz`, feature `viz`) and the end-of-run picture
 //! ([`crate::snapshot::SnapshotSink`]) are sinks too.
 //!
@@ -15,6 +16,7 @@ use perception::raster::SCAN_COLUMNS;
 
 use crate::odom::OdomRecord;
 use crate::output::{DoorOut, ObjectOut, OutputLine, StatsLine, WallOut};
+use crate::scene_line::SceneLine;
 
 /// One finished frame, as the loop hands it to its sinks.
 pub struct FrameView<'a> {
@@ -84,7 +86,20 @@ impl FrameSink for JsonlSink {
     }
 }
 
-/// One human-readable statistics line a revolution.
+/// One human-readable line a frame: what the robot sees ([`SceneLine`]).
+pub struct SceneSink(pub Box<dyn Write>);
+
+impl FrameSink for SceneSink {
+    fn frame(&mut self, f: &FrameView<'_>) -> io::Result<bool> {
+        writeln!(self.0, "{}", SceneLine(&f.line))?;
+        Ok(false)
+    }
+    fn finish(&mut self, _end: &RunEnd<'_>) -> io::Result<()> {
+        self.0.flush()
+    }
+}
+
+/// One human-readable statistics line a revolution (`--verbose`).
 pub struct StatsSink(pub Box<dyn Write>);
 
 impl FrameSink for StatsSink {

@@ -167,6 +167,9 @@ enum Command {
         /// Write the counts here as JSON.
         #[arg(long)]
         json: Option<PathBuf>,
+        /// Draw the phantom rates as a bar chart here (PNG).
+        #[arg(long)]
+        plot: Option<PathBuf>,
     },
 }
 
@@ -428,6 +431,7 @@ fn run(cli: Cli) -> Result<(), String> {
             umbra,
             dir,
             json,
+            plot,
         } => {
             use lab::world_eval::{EvalConfig, Family, evaluate, report};
             let umbra = match umbra {
@@ -471,6 +475,10 @@ fn run(cli: Cli) -> Result<(), String> {
             if let Some(p) = json {
                 let text = serde_json::to_string_pretty(&out).map_err(|e| e.to_string())?;
                 std::fs::write(&p, text + "\n").map_err(|e| format!("{}: {e}", p.display()))?;
+            }
+            if let Some(p) = plot {
+                lab::world_eval::picture::write_phantom_bars(&p, &out)
+                    .map_err(|e| format!("{}: {e}", p.display()))?;
             }
         }
     }

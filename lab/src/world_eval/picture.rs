@@ -122,3 +122,43 @@ pub fn write(path: &Path, title: &str, truth: &RunTruth, lines: &[Line]) -> std:
     }
     c.write_png(path)
 }
+
+/// Phantoms per frame among the reported objects, by source (A, B, AB stacked), one bar per
+/// family and world setting.
+pub fn write_phantom_bars(path: &Path, outcomes: &[super::Outcome]) -> std::io::Result<()> {
+    const BAR: usize = 70;
+    const GAP: usize = 40;
+    const H: f32 = 300.0;
+    let per_frame = |p: &[u32; 3], frames: u32| p.map(|x| f64::from(x) / f64::from(frames.max(1)));
+    let mut bars: Vec<(String, [f64; 3])> = Vec::new();
+    for o in outcomes {
+        let fam = o.family.split(' ').next().unwrap_or("");
+        let t = &o.tally;
+        let on = if o.world { "on" } else { "off" };
+        bars.push((format!("{fam} {on}"), per_frame(&t.phantoms, t.frames)));
+    }
+    let top = bars
+        .iter()
+        .map(|(_, v)| v.iter().sum::<f64>())
+        .fold(0.5, f64::max);
+    let w = 80 + bars.len() * (BAR + GAP);
+    let h = (H as usize) + 120;
+    let mut c = Canvas::new(w.max(620), h);
+    c.text(8, 8, "Phantoms per frame (reported objects on no furniture)", [0, 0, 0]);
+    c.text(8, 30, "A blue, B orange, AB green; world model off / on", [90, 90, 90]);
+    let base = 60.0 + H;
+    let colours = [[40, 90, 220], [230, 130, 20], [30, 160, 60]];
+    for (k, (label, v)) in bars.iter().enumerate() {
+        let x = 60 + k * (BAR + GAP);
+        let mut y = base;
+        for (s, &val) in v.iter().enumerate() {
+            let hgt = (val / top) as f32 * H;
+            c.rect(x, (y - hgt) as usize, BAR, hgt.ceil() as usize, colours[s]);
+            y -= hgt;
+        }
+        c.text(x, (y - 20.0).max(50.0) as usize, &format!("{:.2}", v.iter().sum::<f64>()), [0, 0, 0]);
+        c.text(x, base as usize + 8, label, [0, 0, 0]);
+    }
+    c.line((50.0, base), ((w - 10) as f32, base), 1, [0, 0, 0]);
+    c.write_png(path)
+}
