@@ -133,6 +133,9 @@ mod test {
             "frame      7  t     1.40 s  pose (1.00, -0.50)   90°  | chair #12 (-1.0, 0.5), #4 (0.3, 2.3)  box #3 (2.0, 1.0) | door (4.0, 0.0) 0.92 m  | 14.2 ms"
         );
         let empty = SceneLine(&line(&[], &[])).to_string();
-        assert!(empty.contains("| no objects | no doors  | 14.2 ms"), "{empty}");
+        assert!(
+            empty.contains("| no objects | no doors  | 14.2 ms"),
+            "{empty}"
+        );
     }
 }

@@ -6,7 +6,7 @@
 //! ([`crate::snapshot::SnapshotSink`]) are sinks too.
 //!
 //! A sink runs on the loop's thread: it must not allocate per frame (the counting-allocator
-//! test runs with the JSON and stats sinks, and with the recorder).
+//! test runs with the JSON, scene and stats sinks, and with the recorder).
 
 use std::io::{self, Write};
 

@@ -11,7 +11,7 @@ use firmware::config::Config;
 use firmware::odom::{PoseInput, PoseState};
 use firmware::power::PowerMeter;
 use firmware::runner::{self, MethodBSetup, RunOptions, SecondsClock};
-use firmware::sink::{FrameSink, JsonlSink, StatsSink};
+use firmware::sink::{FrameSink, JsonlSink, SceneSink, StatsSink};
 use firmware::source::{LidarSource, Pacing};
 use firmware::viz::{VizLink, VizSink};
 use umbra_tests::{allocations, counted};
@@ -69,6 +69,7 @@ fn per_frame_from(
     });
     let mut sinks: Vec<Box<dyn FrameSink>> = vec![
         Box::new(JsonlSink(Box::new(Marks(marks.clone())))),
+        Box::new(SceneSink(Box::new(std::io::sink()))),
         Box::new(StatsSink(Box::new(std::io::sink()))),
     ];
     if let Some(link) = viz {

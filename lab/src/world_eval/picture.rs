@@ -144,8 +144,18 @@ pub fn write_phantom_bars(path: &Path, outcomes: &[super::Outcome]) -> std::io::
     let w = 80 + bars.len() * (BAR + GAP);
     let h = (H as usize) + 120;
     let mut c = Canvas::new(w.max(620), h);
-    c.text(8, 8, "Phantoms per frame (reported objects on no furniture)", [0, 0, 0]);
-    c.text(8, 30, "A blue, B orange, AB green; world model off / on", [90, 90, 90]);
+    c.text(
+        8,
+        8,
+        "Phantoms per frame (reported objects on no furniture)",
+        [0, 0, 0],
+    );
+    c.text(
+        8,
+        30,
+        "A blue, B orange, AB green; world model off / on",
+        [90, 90, 90],
+    );
     let base = 60.0 + H;
     let colours = [[40, 90, 220], [230, 130, 20], [30, 160, 60]];
     for (k, (label, v)) in bars.iter().enumerate() {
@@ -156,7 +166,12 @@ pub fn write_phantom_bars(path: &Path, outcomes: &[super::Outcome]) -> std::io::
             c.rect(x, (y - hgt) as usize, BAR, hgt.ceil() as usize, colours[s]);
             y -= hgt;
         }
-        c.text(x, (y - 20.0).max(50.0) as usize, &format!("{:.2}", v.iter().sum::<f64>()), [0, 0, 0]);
+        c.text(
+            x,
+            (y - 20.0).max(50.0) as usize,
+            &format!("{:.2}", v.iter().sum::<f64>()),
+            [0, 0, 0],
+        );
         c.text(x, base as usize + 8, label, [0, 0, 0]);
     }
     c.line((50.0, base), ((w - 10) as f32, base), 1, [0, 0, 0]);
