@@ -13,6 +13,7 @@
 //! | [`canvas`]        | an RGB canvas with a built-in font, written as PNG (the figures)   |
 //! | [`confusion_png`] | the evaluation's confusion matrix as a PNG                        |
 //! | [`pose_eval`]     | drift of odometry, compass overwrite and our fusion on the simulator |
+//! | [`run_truth`]     | what a world-evaluation run really held (both scene families write it) |
 //! | [`world_eval`]    | `eval-world`: `umbra replay`'s world scored on two scene families |
 //! | [`annex`]         | the second scene family, written apart and never trained or tuned on |
 #![deny(unsafe_code, missing_docs)]
@@ -23,5 +24,6 @@ pub mod confusion_png;
 pub mod eval_a;
 pub mod eval_b;
 pub mod pose_eval;
+pub mod run_truth;
 pub mod scenes_a;
 pub mod world_eval;

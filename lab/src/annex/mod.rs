@@ -14,6 +14,7 @@
 //! **Rule:** nothing may be trained, tuned or thresholded on annex scenes. It is an exam.
 
 pub mod drive;
+pub mod furnish;
 pub mod plan;
 pub mod sensor;
 
@@ -24,9 +25,7 @@ use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use sim::scenario::Frame;
 
-use crate::world_eval::truth::{
-    Door, FrameTruth, Furniture, Move, Person, RunTruth, VISIBLE_RETURNS,
-};
+use crate::run_truth::{Door, FrameTruth, Furniture, Move, Person, RunTruth, VISIBLE_RETURNS};
 use drive::{Drive, script};
 use plan::{Owner, Prim};
 

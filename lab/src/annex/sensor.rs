@@ -127,7 +127,6 @@ pub fn passes_through(poly: &[Point2], o: Point2, q: Point2) -> bool {
     let d = Point2::new((q.x - o.x) / o.distance(q), (q.y - o.y) / o.distance(q));
     (0..=n).any(|i| {
         let s = len * i as f32 / n as f32;
-        crate::world_eval::truth::polygon_distance(poly, Point2::new(o.x + d.x * s, o.y + d.y * s))
-            == 0.0
+        crate::run_truth::polygon_distance(poly, Point2::new(o.x + d.x * s, o.y + d.y * s)) == 0.0
     })
 }

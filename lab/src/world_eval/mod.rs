@@ -9,7 +9,6 @@
 pub mod picture;
 pub mod score;
 pub mod sim_family;
-pub mod truth;
 
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -192,7 +191,7 @@ pub fn evaluate(cfg: &EvalConfig, mut progress: impl FnMut(&str)) -> Result<Vec<
 }
 
 /// The run's truth in words (written beside each run).
-pub fn describe(t: &truth::RunTruth) -> String {
+pub fn describe(t: &crate::run_truth::RunTruth) -> String {
     let mut s = format!("{}\n", t.name);
     for (k, f) in t.furniture.iter().enumerate() {
         let c = f.centre();

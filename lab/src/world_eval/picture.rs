@@ -9,8 +9,8 @@ use perception::class::ObjectClass;
 use perception::geometry::Point2;
 
 use super::score::{DOOR_MATCH_M, Line, MATCH_M};
-use super::truth::RunTruth;
 use crate::canvas::Canvas;
+use crate::run_truth::RunTruth;
 
 const PX_PER_M: f32 = 60.0;
 const MARGIN: f32 = 40.0;
@@ -126,8 +126,8 @@ pub fn write(path: &Path, title: &str, truth: &RunTruth, lines: &[Line]) -> std:
 /// Phantoms per frame among the reported objects, by source (A, B, AB stacked), one bar per
 /// family and world setting.
 pub fn write_phantom_bars(path: &Path, outcomes: &[super::Outcome]) -> std::io::Result<()> {
-    const BAR: usize = 70;
-    const GAP: usize = 40;
+    const BAR: usize = 80;
+    const GAP: usize = 60;
     const H: f32 = 300.0;
     let per_frame = |p: &[u32; 3], frames: u32| p.map(|x| f64::from(x) / f64::from(frames.max(1)));
     let mut bars: Vec<(String, [f64; 3])> = Vec::new();
@@ -140,7 +140,8 @@ pub fn write_phantom_bars(path: &Path, outcomes: &[super::Outcome]) -> std::io::
     let top = bars
         .iter()
         .map(|(_, v)| v.iter().sum::<f64>())
-        .fold(0.5, f64::max);
+        .fold(0.5, f64::max)
+        * 1.1;
     let w = 80 + bars.len() * (BAR + GAP);
     let h = (H as usize) + 120;
     let mut c = Canvas::new(w.max(620), h);
@@ -156,7 +157,7 @@ pub fn write_phantom_bars(path: &Path, outcomes: &[super::Outcome]) -> std::io::
         "A blue, B orange, AB green; world model off / on",
         [90, 90, 90],
     );
-    let base = 60.0 + H;
+    let base = 70.0 + H;
     let colours = [[40, 90, 220], [230, 130, 20], [30, 160, 60]];
     for (k, (label, v)) in bars.iter().enumerate() {
         let x = 60 + k * (BAR + GAP);

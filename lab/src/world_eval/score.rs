@@ -7,7 +7,7 @@ use perception::class::ObjectClass;
 use perception::geometry::Point2;
 use serde_json::Value;
 
-use super::truth::{Furniture, RunTruth};
+use crate::run_truth::{Furniture, RunTruth};
 
 /// A reported object is on a piece of furniture when within this distance of its footprint.
 pub const MATCH_M: f32 = 0.3;
@@ -400,7 +400,7 @@ pub fn score_run(truth: &RunTruth, lines: &[Line], tally: &mut Tally) {
     let seen_doors: Vec<_> = truth
         .doors
         .iter()
-        .filter(|d| d.returns >= super::truth::VISIBLE_RETURNS)
+        .filter(|d| d.returns >= crate::run_truth::VISIBLE_RETURNS)
         .collect();
     tally.doors[2] += seen_doors.len() as u32;
     tally.doors[1] += last.doors.len() as u32;
@@ -413,7 +413,7 @@ pub fn score_run(truth: &RunTruth, lines: &[Line], tally: &mut Tally) {
             .position(|(k, t)| !door_taken[k] && t.centre.distance(*d) <= DOOR_MATCH_M)
         {
             door_taken[k] = true;
-            if truth.doors[k].returns >= super::truth::VISIBLE_RETURNS {
+            if truth.doors[k].returns >= crate::run_truth::VISIBLE_RETURNS {
                 tally.doors[0] += 1;
             } else {
                 tally.doors[1] -= 1; // a door too little seen to score
@@ -486,8 +486,8 @@ pub fn ratio(a: u32, b: u32) -> f64 {
 
 #[cfg(test)]
 mod test {
-    use super::super::truth::{Door, FrameTruth, Move};
     use super::*;
+    use crate::run_truth::{Door, FrameTruth, Move};
 
     fn square(c: Point2, h: f32) -> Vec<Point2> {
         vec![

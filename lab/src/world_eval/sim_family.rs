@@ -7,8 +7,8 @@ use sim::dataset::{scenario_config, scenario_seed};
 use sim::scenario::{Frame, Scenario};
 use sim::world::{RoomKind, Surface, WorldConfig};
 
-use super::truth::{Door, FrameTruth, Furniture, RunTruth, VISIBLE_RETURNS};
 use crate::annex::GeneratedRun;
+use crate::run_truth::{Door, FrameTruth, Furniture, RunTruth, VISIBLE_RETURNS};
 
 /// Simulator run `i` of the evaluation seed `seed`: `seconds` long (even runs turn in place,
 /// odd runs tour, as the dataset's scenarios do), all three room kinds, clutter.
