@@ -144,7 +144,8 @@ pub struct Score {
     pub split: u32,
 }
 
-fn class_index(c: ObjectClass) -> Option<usize> {
+/// Index of a furniture class in the evaluators' per-class arrays (chair, box, desk).
+pub(crate) fn class_index(c: ObjectClass) -> Option<usize> {
     match c {
         ObjectClass::Chair => Some(0),
         ObjectClass::Box => Some(1),

@@ -40,12 +40,7 @@ impl Furniture {
 
     /// Centre of the footprint.
     pub fn centre(&self) -> Point2 {
-        let n = self.footprint.len().max(1) as f32;
-        let (x, y) = self
-            .footprint
-            .iter()
-            .fold((0.0, 0.0), |(x, y), p| (x + p.x, y + p.y));
-        Point2::new(x / n, y / n)
+        perception::shape::centroid(&[&self.footprint])
     }
 
     /// Distance from `p` to the footprint (0 inside).

@@ -319,15 +319,12 @@ impl<S: RevolutionStream> FrameLoop<'_, S> {
             let lidar = midway(&pose.start, &pose.end).compose(&mount);
             st.tracks
                 .update(frame, &st.fused, &lidar, st.history.newest(), cfg);
-            for t in st.tracks.confirmed() {
-                st.objects.push(ObjectOut::track(t));
-            }
             // Doors are map entries like objects: the confirmed door-frame tracks, whichever
             // method found them.
             st.doors.clear();
             for t in st.tracks.confirmed() {
+                let o = ObjectOut::track(t);
                 if t.class() == ObjectClass::DoorFrame && t.width_m > 0.0 {
-                    let o = ObjectOut::track(t);
                     push_door(
                         &mut st.doors,
                         DoorOut {
@@ -338,6 +335,7 @@ impl<S: RevolutionStream> FrameLoop<'_, S> {
                         },
                     );
                 }
+                st.objects.push(o);
             }
         } else {
             // Door frames Method B found where Method A found none are doors too.

@@ -85,12 +85,7 @@ pub fn generate(seed: u64, seconds: f64, tour: bool, lidar: LidarModel) -> Gener
             others.pieces.remove(i);
             if let Some(q) = others.free_point(&mut rng, 0.7) {
                 let old = &plan.pieces[i];
-                let c = old.footprint.iter().fold(Point2::new(0.0, 0.0), |a, p| {
-                    Point2::new(
-                        a.x + p.x / old.footprint.len() as f32,
-                        a.y + p.y / old.footprint.len() as f32,
-                    )
-                });
+                let c = old.centre();
                 let shift = |p: Point2| Point2::new(p.x - c.x + q.x, p.y - c.y + q.y);
                 let mut new = old.clone();
                 new.footprint.iter_mut().for_each(|p| *p = shift(*p));

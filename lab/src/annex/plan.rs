@@ -63,11 +63,7 @@ pub struct Piece {
 
 impl Piece {
     pub(super) fn centre(&self) -> Point2 {
-        let n = self.footprint.len() as f32;
-        let s = self.footprint.iter().fold(Point2::new(0.0, 0.0), |a, p| {
-            Point2::new(a.x + p.x, a.y + p.y)
-        });
-        Point2::new(s.x / n, s.y / n)
+        perception::shape::centroid(&[&self.footprint])
     }
 
     pub(super) fn radius(&self) -> f32 {
@@ -440,10 +436,7 @@ impl Plan {
     }
 
     pub(super) fn fits(&self, fp: &[Point2], gap: f32) -> bool {
-        let c = fp.iter().fold(Point2::new(0.0, 0.0), |a, p| {
-            Point2::new(a.x + p.x, a.y + p.y)
-        });
-        let c = Point2::new(c.x / fp.len() as f32, c.y / fp.len() as f32);
+        let c = perception::shape::centroid(&[fp]);
         let r = fp.iter().map(|p| p.distance(c)).fold(0.0, f32::max);
         let mut probes: Vec<Point2> = fp.to_vec();
         for i in 0..fp.len() {

@@ -7,6 +7,7 @@ use perception::class::ObjectClass;
 use perception::geometry::Point2;
 use serde_json::Value;
 
+use crate::eval_a::class_index;
 use crate::run_truth::{Furniture, RunTruth};
 
 /// A reported object is on a piece of furniture when within this distance of its footprint.
@@ -159,15 +160,6 @@ pub struct Tally {
     pub people_frames: u32,
     /// Frames × people in view of a `people` list, and how many it had within reach.
     pub people_found: [u32; 2],
-}
-
-fn class_index(c: ObjectClass) -> Option<usize> {
-    match c {
-        ObjectClass::Chair => Some(0),
-        ObjectClass::Box => Some(1),
-        ObjectClass::Desk => Some(2),
-        ObjectClass::DoorFrame => None,
-    }
 }
 
 /// Class names of the tally's per-class arrays.
