@@ -7,8 +7,11 @@ training (train batches are unpadded) nor at run time. Measured on a 7-epoch mod
 back to 64 x 384; nothing else changes.
 
 The trainer also puts `mirror.MirrorRoom` first in the training transforms, with the
-probability in `ExactTrainer.mirror_p` (0 = off).
+probability in `ExactTrainer.mirror_p` (0 = off), and reads its results.csv with the standard
+library (Ultralytics uses polars, which a machine without a package index may not have).
 """
+
+import csv
 
 from ultralytics.models.yolo.detect import DetectionTrainer, DetectionValidator
 
@@ -38,3 +41,12 @@ class ExactTrainer(DetectionTrainer):
         if self.mirror_p > 0.0:
             ds.transforms.insert(0, MirrorRoom(self.mirror_p))
         return ds
+
+    def read_results_csv(self):
+        """results.csv as {column: [values]}, as Ultralytics' polars reader returns it."""
+        try:
+            with open(self.csv, newline="") as f:
+                rows = list(csv.DictReader(f))
+        except OSError:
+            return {}
+        return {k.strip(): [float(r[k]) for r in rows] for k in (rows[0] if rows else {})}

@@ -36,18 +36,26 @@ SCHEDULE = dict(optimizer="AdamW", lr0=0.00125, lrf=0.01, momentum=0.937, weight
 
 def train(data: Path, epochs: int, batch: int = 32, seed: int = 0, device: str = "cpu",
           workers: int = 2, name: str = "small", resume: bool = False, mirror: float = 0.5,
-          init: Path | None = None, lr0: float | None = None, cache: str | bool = "ram") -> Path:
+          init: Path | None = None, lr0: float | None = None, cache: str | bool = "ram",
+          hours: float | None = None, amp: bool = False) -> Path:
     """Train (or resume) one run; returns its weights folder.
 
     Every image is 64 x 384, so the `rect` batch shapes are all equal and Ultralytics keeps the
     DataLoader's shuffling on (it turns it off only for unequal shapes);
     `training/test_training.py` checks that two epochs see different orders.
+
+    `hours` caps the run's wall time (Ultralytics' `time`: the epoch count is refitted to it after
+    each epoch, and the cosine schedule with it). `amp` is off unless asked for: Ultralytics'
+    AMP check downloads a model, which an offline machine cannot.
     """
     sched = dict(SCHEDULE)
-    if init:
-        sched.update(warmup_epochs=0.2, cos_lr=True)
     if lr0 is not None:
         sched["lr0"] = lr0
+    if init:
+        # Ultralytics' warm-up starts the biases at lr 0.1 over at least 100 iterations, which
+        # undoes a trained model (seen: val mAP50 0.96 -> 0.27 after one short epoch): biases
+        # start at lr0 instead.
+        sched.update(warmup_epochs=0.2, warmup_bias_lr=sched["lr0"], cos_lr=True)
     ExactTrainer.mirror_p = mirror
     weights = HERE / "runs" / name / "weights"
     if resume:
@@ -56,9 +64,10 @@ def train(data: Path, epochs: int, batch: int = 32, seed: int = 0, device: str =
         YOLO(str(HERE / "yolov8n-umbra.yaml")).train(
             data=str(Path(data).resolve()), imgsz=384, rect=True, epochs=epochs, batch=batch,
             workers=workers, device=device, seed=seed, deterministic=True,
-            pretrained=str(init) if init else False, amp=device != "cpu", plots=False,
+            pretrained=str(init) if init else False, amp=amp, plots=False,
             project=str(HERE / "runs"), name=name, exist_ok=True, val=True,
-            trainer=ExactTrainer, cache=cache, **sched, **OFF,
+            trainer=ExactTrainer, cache=cache, **({"time": hours} if hours else {}),
+            **sched, **OFF,
         )
     return weights
 
@@ -78,11 +87,13 @@ def main() -> None:
     ap.add_argument("--resume", action="store_true", help="continue runs/NAME/weights/last.pt")
     ap.add_argument("--lr0", type=float, help=f"initial learning rate (default {SCHEDULE['lr0']})")
     ap.add_argument("--no-cache", action="store_true", help="read images from disk each epoch")
+    ap.add_argument("--hours", type=float, help="stop after this many hours (refits the epochs)")
+    ap.add_argument("--amp", action="store_true", help="mixed precision (GPU, online machines)")
     a = ap.parse_args()
 
     t0 = time.time()
     w = train(Path(a.data), a.epochs, a.batch, a.seed, a.device, a.workers, a.name, a.resume,
-              a.mirror, a.init, a.lr0, False if a.no_cache else "ram")
+              a.mirror, a.init, a.lr0, False if a.no_cache else "ram", a.hours, a.amp)
     print(f"trained in {time.time() - t0:.0f} s: {w}")
 
 

@@ -1,0 +1,62 @@
+#!/usr/bin/env bash
+# One long continuation of Method B's training on a lent GPU machine (the `device` tool), in one
+# command: a fresh simulator dataset made there, training from continue.pt for a fixed wall time,
+# and the weights and log copied to $OUT. Offline: Ultralytics travels as wheels in .whl/ and
+# the simulator as a prebuilt binary in .gpu/ (both git-ignored, carried by the call).
+#
+#   run(command="bash training/gpu_run.sh", carry=[".whl", ".gpu"], timeout_s=600)
+#
+# Knobs (environment): SCENARIOS (16000), SEED (35; never an eval or test seed), HOURS (0.11),
+# BATCH (128), LR0 (0.0005), WORKERS (14), DEVICE (0), PY (python3), NAME (gpu19), LIMIT (560:
+# seconds from the start after which training is interrupted, so the weights saved at the last
+# epoch still come back inside the call's 600 s).
+# Run locally on CPU with e.g. `SCENARIOS=40 HOURS=0.005 DEVICE=cpu PY=.venv/bin/python
+# OUT=/tmp/gpu-out bash training/gpu_run.sh` to check it before spending device time.
+set -euo pipefail
+SCENARIOS=${SCENARIOS:-16000}
+SEED=${SEED:-35}
+HOURS=${HOURS:-0.11}
+BATCH=${BATCH:-128}
+LR0=${LR0:-0.0005}
+WORKERS=${WORKERS:-14}
+DEVICE=${DEVICE:-0}
+PY=${PY:-python3}
+NAME=${NAME:-gpu19}
+DATA=${DATA:-/tmp/umbra-gpu-data}
+: "${OUT:?OUT must name a folder for the results}"
+mkdir -p "$OUT"
+
+if [ -d .whl ]; then
+    "$PY" -m pip install -q --no-index --no-deps --no-compile --no-cache-dir --upgrade \
+        --target /tmp/site .whl/*.whl
+    export PYTHONPATH=/tmp/site
+fi
+command -v nvidia-smi >/dev/null && nvidia-smi -L
+echo "cpus $(nproc); shm: $(df -h /dev/shm | tail -1)"
+# DataLoader workers pass batches through /dev/shm: few workers where it is small.
+shm_kb=$(df -k --output=avail /dev/shm | tail -1)
+[ "$shm_kb" -lt 2000000 ] && WORKERS=2 && echo "small /dev/shm: $WORKERS workers"
+
+LIMIT=${LIMIT:-560}
+t0=$(date +%s)
+rm -rf "$DATA"
+.gpu/umbra-sim dataset --out "$DATA" --scenarios "$SCENARIOS" --frames 4 --seed "$SEED" \
+    --kinds rect,tworooms --clutter 6 --no-method-a --no-recordings --pictures 0 >"$OUT/dataset.log"
+echo "dataset: $(ls "$DATA/images/train" | wc -l) train images in $(( $(date +%s) - t0 )) s"
+
+cd training
+rm -rf "runs/$NAME"
+set +e
+PYTHONUNBUFFERED=1 timeout --signal=INT --kill-after=15 $(( LIMIT - ($(date +%s) - t0) )) \
+    "$PY" train.py --data "$DATA/data.yaml" --device "$DEVICE" --workers "$WORKERS" \
+    --batch "$BATCH" --epochs 100 --hours "$HOURS" --name "$NAME" \
+    --init checkpoints/continue.pt --lr0 "$LR0" --seed "$SEED" 2>&1 | tee "$OUT/train.log" | \
+    grep -v "^ *[0-9]*/[0-9]* .*it/s" | tail -n 60
+rc=${PIPESTATUS[0]}
+set -e
+for f in best.pt last.pt; do
+    [ -f "runs/$NAME/weights/$f" ] && cp "runs/$NAME/weights/$f" "$OUT/$NAME-$f"
+done
+[ -f "runs/$NAME/results.csv" ] && cp "runs/$NAME/results.csv" "$OUT/$NAME-results.csv"
+echo "train.py exit $rc after $(( $(date +%s) - t0 )) s"
+exit "$rc"
