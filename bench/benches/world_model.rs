@@ -103,7 +103,7 @@ fn world(c: &mut Criterion) {
     // Warm the table up on the whole sequence once, so every measured frame meets a full room.
     let mut warm = Tracks::new();
     for (k, f) in frames.iter().enumerate() {
-        warm.update(k as u64, &f.obs, &f.lidar, &f.ranges, &cfg);
+        warm.update(k as u64, k as f64 * 0.2, &f.obs, &f.lidar, &f.ranges, &cfg);
     }
     let mut group = c.benchmark_group("world_model_frame");
     group.bench_function("umbra_tracks_update", |b| {
@@ -111,7 +111,14 @@ fn world(c: &mut Criterion) {
         let mut k = FRAMES as u64;
         b.iter(|| {
             let f = &frames[k as usize % FRAMES];
-            t.update(k, black_box(&f.obs), &f.lidar, &f.ranges, &cfg);
+            t.update(
+                k,
+                k as f64 * 0.2,
+                black_box(&f.obs),
+                &f.lidar,
+                &f.ranges,
+                &cfg,
+            );
             k += 1;
             black_box(t.all().len())
         })

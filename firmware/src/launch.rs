@@ -362,10 +362,7 @@ fn run_loop(
         pose,
         method_a: cfg.method_a.enabled.then(|| (cfg.method_a(), mount)),
         method_b,
-        world: cfg
-            .world
-            .enabled
-            .then(perception::tracks::TrackConfig::default),
+        world: cfg.world.enabled.then(|| cfg.world.tracks()),
     };
     let scheduling = crate::realtime::apply(cfg.runtime.scheduling, cfg.runtime.fifo_priority);
     log::info!("frame loop: {scheduling}");

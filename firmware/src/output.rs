@@ -119,6 +119,37 @@ pub struct DoorOut {
     pub score: f64,
 }
 
+/// A walking person (the world model's moving tracks; never furniture).
+#[derive(Debug, Clone, Copy, Serialize, PartialEq)]
+pub struct PersonOut {
+    /// Track id (shared with objects' ids: never reused).
+    pub id: u32,
+    /// Map frame, m.
+    pub x: f64,
+    /// Map frame, m.
+    pub y: f64,
+    /// Velocity, map frame, m/s.
+    pub vx: f64,
+    /// Velocity, map frame, m/s.
+    pub vy: f64,
+    /// Confidence in [0, 1].
+    pub score: f64,
+}
+
+impl PersonOut {
+    /// From a moving track.
+    pub fn track(t: &Track) -> Self {
+        PersonOut {
+            id: t.id,
+            x: f64::from(t.centre.x),
+            y: f64::from(t.centre.y),
+            vx: f64::from(t.motion.vel.x),
+            vy: f64::from(t.motion.vel.y),
+            score: 1.0 / (1.0 + (-f64::from(t.existence)).exp()),
+        }
+    }
+}
+
 /// Stage times, milliseconds. Stages that do not exist yet are absent, not zero.
 #[derive(Debug, Clone, Copy, Serialize, Default, PartialEq)]
 pub struct TimingOut {
@@ -280,6 +311,10 @@ pub struct OutputLine<'a> {
     /// (`id` is the place in this list), while `objects` are the confirmed tracks.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub detections: Option<&'a [ObjectOut]>,
+    /// With the world model on: the walking people in view (moving tracks, never in
+    /// `objects`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub people: Option<&'a [PersonOut]>,
     /// Stage times.
     pub timing_ms: TimingOut,
     /// The per-frame budget.
@@ -349,6 +384,7 @@ mod test {
             walls: &[],
             doors: &[],
             detections: None,
+            people: None,
             timing_ms: TimingOut {
                 ingest: 0.1,
                 pose: 0.0,

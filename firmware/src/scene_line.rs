@@ -1,5 +1,5 @@
 //! The human-readable line of a frame: what the robot sees — its pose, the objects by class
-//! with their ids and places, the doors, and the frame's time. (The LiDAR's own statistics
+//! with their ids and places, the doors, the people walking by, and the frame's time. (The LiDAR's own statistics
 //! are `--verbose`'s line.)
 
 use core::fmt;
@@ -58,6 +58,20 @@ impl fmt::Display for SceneLine<'_> {
                 write!(f, "{sep}({:.1}, {:.1}) {:.2} m", z(d.x), z(d.y), d.width)?;
             }
         }
+        if let Some(people) = l.people.filter(|p| !p.is_empty()) {
+            f.write_str("  | walking:")?;
+            for (k, p) in people.iter().enumerate() {
+                let sep = if k == 0 { " " } else { ", " };
+                let speed = p.vx.hypot(p.vy);
+                write!(
+                    f,
+                    "{sep}#{} ({:.1}, {:.1}) {speed:.1} m/s",
+                    p.id,
+                    z(p.x),
+                    z(p.y)
+                )?;
+            }
+        }
         write!(f, "  | {:.1} ms", l.timing_ms.total)?;
         if l.deadline_missed {
             f.write_str(" MISSED")?;
@@ -69,7 +83,7 @@ impl fmt::Display for SceneLine<'_> {
 #[cfg(test)]
 mod test {
     use super::*;
-    use crate::output::{DoorOut, FaultsOut, LidarOut, ObjectOut, PoseOut, TimingOut};
+    use crate::output::{DoorOut, FaultsOut, LidarOut, ObjectOut, PersonOut, PoseOut, TimingOut};
     use perception::fusion::Evidence;
 
     fn object(id: u32, class: ObjectClass, x: f64, y: f64) -> ObjectOut {
@@ -99,6 +113,7 @@ mod test {
             walls: &[],
             doors,
             detections: None,
+            people: None,
             timing_ms: TimingOut {
                 total: 14.2,
                 ..TimingOut::default()
@@ -131,6 +146,21 @@ mod test {
         assert_eq!(
             s,
             "frame      7  t     1.40 s  pose (1.00, -0.50)   90°  | chair #12 (-1.0, 0.5), #4 (0.3, 2.3)  box #3 (2.0, 1.0) | door (4.0, 0.0) 0.92 m  | 14.2 ms"
+        );
+        let walker = [PersonOut {
+            id: 20,
+            x: 1.0,
+            y: 2.0,
+            vx: 0.6,
+            vy: -0.8,
+            score: 0.9,
+        }];
+        let mut l = line(&objects, &doors);
+        l.people = Some(&walker);
+        let s = SceneLine(&l).to_string();
+        assert!(
+            s.ends_with("0.92 m  | walking: #20 (1.0, 2.0) 1.0 m/s  | 14.2 ms"),
+            "{s}"
         );
         let empty = SceneLine(&line(&[], &[])).to_string();
         assert!(

@@ -547,7 +547,10 @@ fn replay_of_a_simulated_recording_finds_its_true_objects() {
             if !frame["walls"].as_array().unwrap().is_empty() {
                 with_walls += 1;
             }
-            for o in frame["objects"].as_array().unwrap() {
+            // The frame's own detections: `detections` with the world model on (the default),
+            // `objects` with it off.
+            let found = frame.get("detections").unwrap_or(&frame["objects"]);
+            for o in found.as_array().unwrap() {
                 let src = o["source"].as_str().unwrap();
                 let hit = t["objects"].as_array().unwrap().iter().any(|g| {
                     g["class"] == o["class"]

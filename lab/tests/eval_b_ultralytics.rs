@@ -38,7 +38,7 @@ fn evaluator_agrees_with_ultralytics() {
     let stats =
         lab::eval_b::evaluate(&mut model, Path::new(&dir), "test", |_, _| {}).expect("evaluation");
     std::fs::remove_dir_all(&dir).ok();
-    let m = stats.metrics();
+    let m = stats.ours.metrics();
     println!("{}", lab::eval_b::table(&m));
     assert_eq!(m.images, refs["images"].as_u64().unwrap_or(100) as usize);
     let close = |what: &str, ours: f64, theirs: &serde_json::Value| {

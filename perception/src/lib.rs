@@ -21,6 +21,8 @@
 //! | [`yolo`]       | Method B's output: YOLOv8 decode, suppression, map-frame centres |
 //! | [`plausible`]  | furniture that cannot be: centres in or behind a wall seen this revolution |
 //! | [`fusion`]     | one frame's objects from both methods: A's, and B's joined or added |
+//! | [`sight`]      | what a revolution showed of a footprint: hidden, in view, seen empty |
+//! | [`motion`]     | a track's alpha–beta motion filter; walking legs told from furniture |
 //! | [`tracks`]     | the world model's tracks: stable ids, association, evidence, negative evidence |
 //!
 //! Each capacity is a named constant listed in
@@ -37,10 +39,12 @@ pub mod fusion;
 pub mod geometry;
 pub mod merge;
 pub mod method_a;
+pub mod motion;
 pub mod plausible;
 pub mod pose;
 pub mod raster;
 pub mod shape;
+pub mod sight;
 pub mod tracks;
 pub mod walls;
 pub mod yolo;

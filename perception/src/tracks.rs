@@ -34,12 +34,14 @@ use heapless::Vec;
 use crate::class::ObjectClass;
 use crate::fusion::{Evidence, FrameObject};
 use crate::geometry::{Point2, Pose2};
+use crate::motion::{Motion, MotionConfig};
+use crate::sight::{BINS, View, view};
 
 /// Tracks held at most.
 pub const MAX_TRACKS: usize = 64;
 
-/// Bins of a revolution (1° each, counter-clockwise from the LiDAR's forward axis).
-const BINS: usize = 360;
+/// A person is listed while seen in one of this many frames.
+pub const PEOPLE_FRAMES: u64 = 3;
 
 /// Tuning of the track table.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -77,6 +79,8 @@ pub struct TrackConfig {
     pub max_range_m: f32,
     /// Farthest from the robot an observation is believed, m (beyond: refused as absurd).
     pub max_observation_m: f32,
+    /// What makes a track a walking person's (never furniture).
+    pub motion: MotionConfig,
 }
 
 impl Default for TrackConfig {
@@ -97,6 +101,7 @@ impl Default for TrackConfig {
             max_weight: 10.0,
             max_range_m: 3.5,
             max_observation_m: 12.0,
+            motion: MotionConfig::default(),
         }
     }
 }
@@ -133,6 +138,8 @@ pub struct Track {
     /// Width across, m (door frames: the clear width, a running mean of the observations
     /// that carry one); 0 = unknown.
     pub width_m: f32,
+    /// Position and velocity from the observations alone; whether it walks.
+    pub motion: Motion,
 }
 
 impl Track {
@@ -157,6 +164,11 @@ impl Track {
         }
     }
 
+    /// A walking person's legs (never furniture): see [`crate::motion`].
+    pub fn moving(&self) -> bool {
+        self.motion.moving
+    }
+
     /// Which methods have seen it.
     pub fn evidence(&self) -> Evidence {
         match (self.seen_a, self.seen_b) {
@@ -176,7 +188,9 @@ impl Track {
 /// both methods agreed on it in one frame, more hits and a steady detection rate while in
 /// view (Method A seeing it once and Method B once, in different frames, is not agreement).
 fn earns_report(t: &Track, cfg: &TrackConfig) -> bool {
-    let base = t.hits >= cfg.confirm_hits && t.existence >= cfg.confirm_existence;
+    let base = t.motion.settled(&cfg.motion)
+        && t.hits >= cfg.confirm_hits
+        && t.existence >= cfg.confirm_existence;
     base && (t.agreed
         || (t.hits >= cfg.single_method_hits
             && t.hits as f32 >= cfg.single_method_rate * t.views as f32))
@@ -274,16 +288,28 @@ impl Tracks {
         self.tracks.iter().filter(|t| t.confirmed)
     }
 
+    /// The people: moving tracks seen in one of the last [`PEOPLE_FRAMES`] frames up to
+    /// `frame`, with at least [`TrackConfig::confirm_hits`] hits.
+    pub fn people(&self, frame: u64, cfg: &TrackConfig) -> impl Iterator<Item = &Track> + '_ {
+        let hits = cfg.confirm_hits;
+        self.tracks.iter().filter(move |t| {
+            t.motion.moving && t.hits >= hits && frame.saturating_sub(t.last_seen) < PEOPLE_FRAMES
+        })
+    }
+
     /// Counters.
     pub fn stats(&self) -> &TrackStats {
         &self.stats
     }
 
-    /// One frame: `obs` are the frame's objects (map frame), `lidar` the LiDAR's pose in the
-    /// map at the revolution, `ranges` its 360 bins (0 = no return).
+    /// One frame: `obs` are the frame's objects (map frame), `stamp_s` the revolution's time
+    /// (s, any origin; it times the motion filter), `lidar` the LiDAR's pose in the map at the
+    /// revolution, `ranges` its 360 bins (0 = no return).
+    #[allow(clippy::too_many_arguments)]
     pub fn update(
         &mut self,
         frame: u64,
+        stamp_s: f64,
         obs: &[FrameObject],
         lidar: &Pose2,
         ranges: &[f32; BINS],
@@ -319,7 +345,11 @@ impl Tracks {
                     if used[k] {
                         continue;
                     }
-                    let d = t.centre.distance(o.centre);
+                    // Looked for where it stands, or where its walk has taken it.
+                    let d = t
+                        .centre
+                        .distance(o.centre)
+                        .min(t.motion.predict(stamp_s).distance(o.centre));
                     // A desk's centre moves with the view more than a chair's (its legs
                     // come and go behind each other): desks gate at their own radius.
                     let desks = t.class() == ObjectClass::Desk && o.class == ObjectClass::Desk;
@@ -343,7 +373,7 @@ impl Tracks {
             let Some((_, i, k)) = best else { break };
             matched[i] = true;
             used[k] = true;
-            Self::hit(&mut self.tracks[i], &obs[k], frame, cfg);
+            Self::hit(&mut self.tracks[i], &obs[k], frame, stamp_s, cfg);
         }
         // Negative evidence for the unmatched tracks in view.
         if pose_ok {
@@ -351,7 +381,7 @@ impl Tracks {
                 if matched[i] {
                     continue;
                 }
-                let loss = match view(t, lidar, ranges, cfg) {
+                let loss = match view(t.centre, t.radius(), lidar, ranges, cfg.max_range_m) {
                     View::Empty => cfg.free_loss,
                     View::Plain => cfg.miss_loss,
                     View::Hidden => 0.0,
@@ -403,8 +433,9 @@ impl Tracks {
                 agreed: false,
                 confirmed: false,
                 width_m: 0.0,
+                motion: Motion::new(o.centre, stamp_s),
             };
-            Self::hit(&mut t, o, frame, cfg);
+            Self::hit(&mut t, o, frame, stamp_s, cfg);
             if self.tracks.push(t).is_ok() {
                 self.next_id = self.next_id.wrapping_add(1);
                 self.stats.created += 1;
@@ -412,7 +443,12 @@ impl Tracks {
         }
     }
 
-    fn hit(t: &mut Track, o: &FrameObject, frame: u64, cfg: &TrackConfig) {
+    fn hit(t: &mut Track, o: &FrameObject, frame: u64, stamp_s: f64, cfg: &TrackConfig) {
+        if t.hits > 0 {
+            let legs = |c: ObjectClass| matches!(c, ObjectClass::Chair | ObjectClass::Box);
+            let may_move = legs(o.class) && legs(t.class());
+            t.motion.observe(o.centre, stamp_s, &cfg.motion, may_move);
+        }
         let w = o.score.clamp(0.05, 1.0);
         let total = t.weight + w;
         t.centre = Point2::new(
@@ -441,7 +477,11 @@ impl Tracks {
                 t.agreed = true;
             }
         }
-        if earns_report(t, cfg) {
+        if t.motion.moving {
+            // A walking person: where the legs are now, never furniture.
+            t.centre = t.motion.pos;
+            t.confirmed = false;
+        } else if earns_report(t, cfg) {
             t.confirmed = true;
         }
     }
@@ -454,8 +494,10 @@ impl Tracks {
             let mut j = i + 1;
             while j < self.tracks.len() {
                 let (a, b) = (&self.tracks[i], &self.tracks[j]);
-                let same =
-                    a.class() == b.class() && a.centre.distance(b.centre) < merge_radius(a.class());
+                let same = !a.motion.moving
+                    && !b.motion.moving
+                    && a.class() == b.class()
+                    && a.centre.distance(b.centre) < merge_radius(a.class());
                 if !same {
                     j += 1;
                     continue;
@@ -517,54 +559,6 @@ impl Tracks {
     }
 }
 
-/// What a revolution showed of a track's footprint.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-enum View {
-    /// Out of range, inside the robot's own footprint, or behind something nearer.
-    Hidden,
-    /// In plain view: the rays reach it (they end inside its footprint).
-    Plain,
-    /// Seen empty: at least two rays cross it and every one that returned did so from beyond.
-    Empty,
-}
-
-/// What this revolution showed of the track's footprint.
-fn view(t: &Track, lidar: &Pose2, ranges: &[f32; BINS], cfg: &TrackConfig) -> View {
-    let local = lidar.inverse().transform(t.centre);
-    let dist = libm::sqrtf(local.x * local.x + local.y * local.y);
-    let r = t.radius();
-    if dist <= r || dist + r > cfg.max_range_m {
-        return View::Hidden;
-    }
-    let bearing = libm::atan2f(local.y, local.x).to_degrees();
-    let half = libm::asinf((r / dist).min(1.0)).to_degrees();
-    let (lo, hi) = (
-        libm::ceilf(bearing - half) as i32,
-        libm::floorf(bearing + half) as i32,
-    );
-    let (mut beyond, mut inside, mut before) = (0, 0, 0);
-    for d in lo..=hi {
-        let range = ranges[d.rem_euclid(BINS as i32) as usize];
-        if range <= 0.0 || !range.is_finite() {
-            continue; // no return: says nothing (dark surfaces drop out)
-        }
-        if range < dist - r {
-            before += 1;
-        } else if range < dist + r {
-            inside += 1;
-        } else {
-            beyond += 1;
-        }
-    }
-    if inside == 0 && before == 0 && beyond >= 2 {
-        View::Empty
-    } else if inside > 0 && inside >= before {
-        View::Plain
-    } else {
-        View::Hidden
-    }
-}
-
 #[cfg(test)]
 mod test {
     use super::*;
@@ -580,6 +574,30 @@ mod test {
         }
     }
 
+    /// The default tuning without the wait before a new track may be reported
+    /// ([`MotionConfig::settle_s`]), for the tests about something else.
+    fn quick() -> TrackConfig {
+        TrackConfig {
+            motion: MotionConfig {
+                settle_s: 0.0,
+                ..MotionConfig::default()
+            },
+            ..TrackConfig::default()
+        }
+    }
+
+    /// One update at frame `f`, five revolutions a second.
+    fn step(
+        t: &mut Tracks,
+        f: u64,
+        obs: &[FrameObject],
+        lidar: &Pose2,
+        ranges: &[f32; BINS],
+        cfg: &TrackConfig,
+    ) {
+        t.update(f, f as f64 * 0.2, obs, lidar, ranges, cfg);
+    }
+
     /// A revolution from the origin facing +x with every ray returning at `r` m.
     fn ranges(r: f32) -> [f32; BINS] {
         [r; BINS]
@@ -593,7 +611,7 @@ mod test {
         // One method confirms as fast as two here: this test is about something else.
         let cfg = TrackConfig {
             single_method_hits: 3,
-            ..TrackConfig::default()
+            ..quick()
         };
         let scan = ranges(0.0);
         for f in 0..5u64 {
@@ -602,7 +620,7 @@ mod test {
             let a = obs(CHAIR, 1.0 + j, 0.0, 0.8, Evidence::A);
             let b = obs(ObjectClass::Box, -1.0, 1.0 - j, 0.9, Evidence::B);
             let list = if f % 2 == 0 { [a, b] } else { [b, a] };
-            t.update(f, &list, &Pose2::IDENTITY, &scan, &cfg);
+            step(&mut t, f, &list, &Pose2::IDENTITY, &scan, &cfg);
             assert_eq!(t.all().len(), 2);
             assert_eq!(
                 t.confirmed().count(),
@@ -630,9 +648,10 @@ mod test {
     #[test]
     fn a_flickering_phantom_is_never_confirmed_and_dies_unseen() {
         let mut t = Tracks::new();
-        let cfg = TrackConfig::default();
+        let cfg = quick();
         let scan = ranges(0.0);
-        t.update(
+        step(
+            &mut t,
             0,
             &[obs(CHAIR, 2.0, 0.0, 0.5, Evidence::A)],
             &Pose2::IDENTITY,
@@ -640,7 +659,7 @@ mod test {
             &cfg,
         );
         for f in 1..=cfg.tentative_frames + 1 {
-            t.update(f, &[], &Pose2::IDENTITY, &scan, &cfg);
+            step(&mut t, f, &[], &Pose2::IDENTITY, &scan, &cfg);
             assert_eq!(t.confirmed().count(), 0);
         }
         assert!(t.all().is_empty());
@@ -650,14 +669,15 @@ mod test {
     #[test]
     fn a_moved_object_leaves_when_its_place_is_seen_empty() {
         let mut t = Tracks::new();
-        let cfg = TrackConfig::default();
+        let cfg = quick();
         // A box 2 m ahead: its rays return at 2 m.
         let mut scan = ranges(3.4);
         for d in [358usize, 359, 0, 1, 2] {
             scan[d] = 1.9;
         }
         for f in 0..6 {
-            t.update(
+            step(
+                &mut t,
                 f,
                 &[obs(ObjectClass::Box, 2.0, 0.0, 0.9, Evidence::AB)],
                 &Pose2::IDENTITY,
@@ -672,7 +692,7 @@ mod test {
         while !t.all().is_empty() {
             frames += 1;
             assert!(frames < 20, "still there after {frames} frames");
-            t.update(5 + frames, &[], &Pose2::IDENTITY, &empty, &cfg);
+            step(&mut t, 5 + frames, &[], &Pose2::IDENTITY, &empty, &cfg);
         }
         assert!(frames <= 10, "gone within 2 s (10 frames): {frames}");
     }
@@ -683,11 +703,12 @@ mod test {
         // One method confirms as fast as two here: this test is about something else.
         let cfg = TrackConfig {
             single_method_hits: 3,
-            ..TrackConfig::default()
+            ..quick()
         };
         let scan = ranges(0.0);
         for f in 0..4 {
-            t.update(
+            step(
+                &mut t,
                 f,
                 &[obs(CHAIR, 2.0, 0.0, 0.9, Evidence::A)],
                 &Pose2::IDENTITY,
@@ -698,7 +719,7 @@ mod test {
         let before = t.all()[0];
         // Something stands in front of it (returns at 1 m), then nothing returns at all.
         for (f, scan) in [(4, ranges(1.0)), (5, ranges(0.0))] {
-            t.update(f, &[], &Pose2::IDENTITY, &scan, &cfg);
+            step(&mut t, f, &[], &Pose2::IDENTITY, &scan, &cfg);
         }
         assert_eq!(t.all()[0].existence, before.existence);
         assert!(t.all()[0].confirmed);
@@ -707,13 +728,14 @@ mod test {
     #[test]
     fn legs_inside_the_footprint_are_not_seen_as_empty() {
         let mut t = Tracks::new();
-        let cfg = TrackConfig::default();
+        let cfg = quick();
         // A chair 2 m ahead: rays pass between its legs (to 3.4 m) except two on legs.
         let mut scan = ranges(3.4);
         scan[4] = 2.1;
         scan[356] = 1.9;
         for f in 0..4 {
-            t.update(
+            step(
+                &mut t,
                 f,
                 &[obs(CHAIR, 2.0, 0.0, 0.9, Evidence::A)],
                 &Pose2::IDENTITY,
@@ -723,7 +745,7 @@ mod test {
         }
         let seen = t.all()[0].existence;
         // Not detected for a frame while in plain view: a missed detection, not an empty place.
-        t.update(4, &[], &Pose2::IDENTITY, &scan, &cfg);
+        step(&mut t, 4, &[], &Pose2::IDENTITY, &scan, &cfg);
         let after = t.all()[0].existence;
         assert!(
             (seen - after - cfg.miss_loss).abs() < 1e-6,
@@ -735,18 +757,19 @@ mod test {
     #[test]
     fn bad_input_is_counted_not_tracked() {
         let mut t = Tracks::new();
-        let cfg = TrackConfig::default();
+        let cfg = quick();
         let scan = ranges(0.0);
         let bad = [
             obs(CHAIR, f32::NAN, 0.0, 0.9, Evidence::A),
             obs(CHAIR, 1.0, 0.0, f32::INFINITY, Evidence::A),
             obs(CHAIR, 1e9, 0.0, 0.9, Evidence::A),
         ];
-        t.update(0, &bad, &Pose2::IDENTITY, &scan, &cfg);
+        step(&mut t, 0, &bad, &Pose2::IDENTITY, &scan, &cfg);
         assert!(t.all().is_empty());
         assert_eq!(t.stats().rejected, 3);
         let lost = Pose2::new(f32::NAN, 0.0, 0.0);
-        t.update(
+        step(
+            &mut t,
             1,
             &[obs(CHAIR, 1.0, 0.0, 0.9, Evidence::A)],
             &lost,
@@ -763,11 +786,12 @@ mod test {
     #[test]
     fn a_full_table_evicts_the_weakest_and_counts_it() {
         let mut t = Tracks::new();
-        let cfg = TrackConfig::default();
+        let cfg = quick();
         let scan = ranges(0.0);
         // One strong confirmed track, then more tentative ones than fit.
         for f in 0..4 {
-            t.update(
+            step(
+                &mut t,
                 f,
                 &[obs(CHAIR, 0.0, 5.0, 1.0, Evidence::AB)],
                 &Pose2::IDENTITY,
@@ -780,7 +804,7 @@ mod test {
             let (x, y) = ((k % 10) as f32 - 4.5, -2.0 - (k / 10) as f32);
             let _ = many.push(obs(ObjectClass::Box, x, y, 0.3, Evidence::B));
         }
-        t.update(4, &many, &Pose2::IDENTITY, &scan, &cfg);
+        step(&mut t, 4, &many, &Pose2::IDENTITY, &scan, &cfg);
         assert_eq!(t.all().len(), MAX_TRACKS);
         assert_eq!(t.stats().evicted, 70 + 1 - MAX_TRACKS as u64);
         assert!(
@@ -792,16 +816,18 @@ mod test {
     #[test]
     fn door_frames_and_furniture_never_merge() {
         let mut t = Tracks::new();
-        let cfg = TrackConfig::default();
+        let cfg = quick();
         let scan = ranges(0.0);
-        t.update(
+        step(
+            &mut t,
             0,
             &[obs(ObjectClass::DoorFrame, 1.0, 0.0, 0.9, Evidence::A)],
             &Pose2::IDENTITY,
             &scan,
             &cfg,
         );
-        t.update(
+        step(
+            &mut t,
             1,
             &[obs(CHAIR, 1.1, 0.0, 0.9, Evidence::B)],
             &Pose2::IDENTITY,
@@ -816,13 +842,14 @@ mod test {
         // One method confirms as fast as two here: this test is about something else.
         let cfg = TrackConfig {
             single_method_hits: 3,
-            ..TrackConfig::default()
+            ..quick()
         };
         let mut t = Tracks::new();
         let far = [0.0f32; BINS];
         // A chair confirmed at (2, 0).
         for f in 0..4 {
-            t.update(
+            step(
+                &mut t,
                 f,
                 &[obs(ObjectClass::Chair, 2.0, 0.0, 0.9, Evidence::A)],
                 &Pose2::IDENTITY,
@@ -838,9 +865,9 @@ mod test {
             obs(ObjectClass::Chair, 2.0, 0.0, 0.9, Evidence::A),
             obs(ObjectClass::Chair, 2.3, 0.0, 0.9, Evidence::B),
         ];
-        t.update(4, &both, &Pose2::IDENTITY, &far, &cfg);
+        step(&mut t, 4, &both, &Pose2::IDENTITY, &far, &cfg);
         assert_eq!(t.all().len(), 2);
-        t.update(5, &[], &Pose2::IDENTITY, &far, &cfg);
+        step(&mut t, 5, &[], &Pose2::IDENTITY, &far, &cfg);
         assert_eq!(t.all().len(), 1, "{:?}", t.all());
         assert_eq!(t.all()[0].id, id.unwrap());
         assert_eq!(t.all()[0].evidence(), Evidence::AB);
@@ -852,18 +879,19 @@ mod test {
                 obs(ObjectClass::Chair, 2.0, 0.0, 0.9, Evidence::A),
                 obs(ObjectClass::Chair, 2.0, 0.5, 0.9, Evidence::A),
             ];
-            t.update(f, &o, &Pose2::IDENTITY, &far, &cfg);
+            step(&mut t, f, &o, &Pose2::IDENTITY, &far, &cfg);
         }
         assert_eq!(t.confirmed().count(), 2);
     }
 
     #[test]
     fn a_desk_seen_from_elsewhere_keeps_its_track() {
-        let cfg = TrackConfig::default();
+        let cfg = quick();
         let mut t = Tracks::new();
         let far = [0.0f32; BINS];
         for f in 0..4 {
-            t.update(
+            step(
+                &mut t,
                 f,
                 &[obs(ObjectClass::Desk, 2.0, 0.0, 0.9, Evidence::B)],
                 &Pose2::IDENTITY,
@@ -872,7 +900,8 @@ mod test {
             );
         }
         // Its centre estimate 0.8 m away (other legs in view): the same desk.
-        t.update(
+        step(
+            &mut t,
             4,
             &[obs(ObjectClass::Desk, 2.8, 0.0, 0.9, Evidence::B)],
             &Pose2::IDENTITY,
@@ -883,7 +912,8 @@ mod test {
         // A chair 0.8 m from a chair is another chair.
         let mut t = Tracks::new();
         for f in 0..4 {
-            t.update(
+            step(
+                &mut t,
                 f,
                 &[obs(ObjectClass::Chair, 2.0, 0.0, 0.9, Evidence::B)],
                 &Pose2::IDENTITY,
@@ -891,7 +921,8 @@ mod test {
                 &cfg,
             );
         }
-        t.update(
+        step(
+            &mut t,
             4,
             &[obs(ObjectClass::Chair, 2.8, 0.0, 0.9, Evidence::B)],
             &Pose2::IDENTITY,
@@ -903,12 +934,13 @@ mod test {
 
     #[test]
     fn one_method_alone_needs_more_hits_and_a_steady_rate() {
-        let cfg = TrackConfig::default();
+        let cfg = quick();
         let scan = ranges(0.0);
         // Both methods: reported at the third hit.
         let mut t = Tracks::new();
         for f in 0..3 {
-            t.update(
+            step(
+                &mut t,
                 f,
                 &[obs(CHAIR, 2.0, 0.0, 0.9, Evidence::AB)],
                 &Pose2::IDENTITY,
@@ -921,7 +953,8 @@ mod test {
         let mut t = Tracks::new();
         for f in 0..8u64 {
             assert_eq!(t.confirmed().count(), 0, "frame {f}");
-            t.update(
+            step(
+                &mut t,
                 f,
                 &[obs(CHAIR, 2.0, 0.0, 0.9, Evidence::B)],
                 &Pose2::IDENTITY,
@@ -937,8 +970,74 @@ mod test {
         for f in 0..40u64 {
             let o = [obs(CHAIR, 2.0, 0.0, 0.9, Evidence::B)];
             let seen: &[FrameObject] = if f % 2 == 0 { &o } else { &[] };
-            t.update(f, seen, &Pose2::IDENTITY, &on_it, &cfg);
+            step(&mut t, f, seen, &Pose2::IDENTITY, &on_it, &cfg);
             assert_eq!(t.confirmed().count(), 0, "frame {f}");
+        }
+    }
+
+    #[test]
+    fn walking_legs_are_a_person_never_furniture() {
+        let cfg = TrackConfig::default();
+        let scan = ranges(0.0);
+        // Legs seen by both methods as a chair, walking +x at a slow, a usual and a brisk pace
+        // past a real chair at (2, 0.6), the legs' centre swinging ±0.08 m with the stride;
+        // five revolutions a second.
+        for speed in [0.5f32, 0.8, 1.1] {
+            let mut t = Tracks::new();
+            let mut listed = 0;
+            for f in 0..25u64 {
+                let swing = if f % 2 == 0 { 0.08 } else { -0.08 };
+                let x = 0.2 + speed * 0.2 * f as f32 + swing;
+                let list = [
+                    obs(CHAIR, x, 0.0, 0.8, Evidence::AB),
+                    obs(CHAIR, 2.0, 0.6, 0.8, Evidence::AB),
+                ];
+                step(&mut t, f, &list, &Pose2::IDENTITY, &scan, &cfg);
+                let people: heapless::Vec<&Track, 4> = t.people(f, &cfg).collect();
+                assert!(people.len() <= 1, "{speed} m/s, frame {f}");
+                if let Some(p) = people.first() {
+                    listed += 1;
+                    assert!(
+                        (p.centre.x - x).abs() < 0.25,
+                        "{speed}: {} vs {x}",
+                        p.centre.x
+                    );
+                    assert!(
+                        (p.motion.vel.x - speed).abs() < 0.35,
+                        "vx {}",
+                        p.motion.vel.x
+                    );
+                }
+                // Only the real chair is ever furniture.
+                for c in t.confirmed() {
+                    assert!(
+                        c.centre.distance(Point2::new(2.0, 0.6)) < 0.1,
+                        "{speed} m/s, frame {f}: {c:?}"
+                    );
+                }
+            }
+            assert_eq!(t.confirmed().count(), 1);
+            // Listed from within 2.5 s of the walk's start to its end.
+            assert!(listed >= 12, "{speed} m/s: listed in {listed} frames");
+            // The person walks out of sight: listed no more after a few frames.
+            for f in 25..29u64 {
+                step(&mut t, f, &[], &Pose2::IDENTITY, &scan, &cfg);
+            }
+            assert_eq!(t.people(28, &cfg).count(), 0);
+        }
+    }
+
+    #[test]
+    fn a_new_piece_is_reported_once_seen_still_for_a_second() {
+        let cfg = TrackConfig::default();
+        let scan = ranges(0.0);
+        let mut t = Tracks::new();
+        for f in 0..8u64 {
+            let j = if f % 2 == 0 { 0.05 } else { -0.05 };
+            let o = [obs(CHAIR, 2.0 + j, 0.0, 0.8, Evidence::AB)];
+            step(&mut t, f, &o, &Pose2::IDENTITY, &scan, &cfg);
+            // 0.2 s a frame: reported from the sixth frame (1 s after the first).
+            assert_eq!(t.confirmed().count(), usize::from(f >= 5), "frame {f}");
         }
     }
 }

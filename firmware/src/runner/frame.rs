@@ -20,7 +20,7 @@ use super::method_b::MethodBScratch;
 use crate::deadline::{DeadlineRecord, FrameTimes, Policy, SHRINK_DROP_FRACTION};
 use crate::odom::{FramePose, PoseInput};
 use crate::output::{
-    DoorOut, FaultsOut, LidarOut, ObjectOut, OutputLine, PoseOut, TimingOut, WallOut,
+    DoorOut, FaultsOut, LidarOut, ObjectOut, OutputLine, PersonOut, PoseOut, TimingOut, WallOut,
 };
 use crate::record_format::RECORD_RAW_BYTES;
 use crate::sink::FrameView;
@@ -66,6 +66,8 @@ pub(super) struct FrameState {
     objects: Vec<ObjectOut>,
     /// This frame's detections, as the line carries them.
     detections: Vec<ObjectOut>,
+    /// The walking people (world model on).
+    people: Vec<PersonOut>,
     pub(super) walls: Vec<WallOut>,
     pub(super) doors: Vec<DoorOut>,
     /// Detections dropped for lying in or behind a wall (`perception::plausible`).
@@ -102,6 +104,7 @@ impl FrameState {
             power_peak: 0.0,
             objects: Vec::with_capacity(perception::tracks::MAX_TRACKS),
             detections: Vec::with_capacity(perception::fusion::MAX_FRAME_OBJECTS),
+            people: Vec::with_capacity(perception::tracks::MAX_TRACKS),
             walls: Vec::with_capacity(perception::walls::MAX_SEGMENTS),
             doors: Vec::with_capacity(
                 perception::doors::MAX_DOORS + perception::tracks::MAX_TRACKS,
@@ -317,8 +320,13 @@ impl<S: RevolutionStream> FrameLoop<'_, S> {
         st.objects.clear();
         if let Some(cfg) = opts.world.as_ref() {
             let lidar = midway(&pose.start, &pose.end).compose(&mount);
+            let mid_s = t + period * 0.5;
             st.tracks
-                .update(frame, &st.fused, &lidar, st.history.newest(), cfg);
+                .update(frame, mid_s, &st.fused, &lidar, st.history.newest(), cfg);
+            st.people.clear();
+            for p in st.tracks.people(frame, cfg) {
+                st.people.push(PersonOut::track(p));
+            }
             // Doors are map entries like objects: the confirmed door-frame tracks, whichever
             // method found them.
             st.doors.clear();
@@ -410,6 +418,7 @@ impl<S: RevolutionStream> FrameLoop<'_, S> {
                 walls: &st.walls,
                 doors: &st.doors,
                 detections: opts.world.is_some().then_some(&st.detections[..]),
+                people: opts.world.is_some().then_some(&st.people[..]),
                 timing_ms: TimingOut::from(times),
                 deadline_ms: opts.budgets.deadline_ms,
                 deadline_missed: missed,

@@ -170,6 +170,10 @@ enum Command {
         /// Draw the phantom rates as a bar chart here (PNG).
         #[arg(long)]
         plot: Option<PathBuf>,
+        /// A `[world]` setting for the world-on replays, e.g. `--world-set settle_s=0`
+        /// (repeatable; for ablations).
+        #[arg(long = "world-set", value_name = "KEY=VALUE")]
+        world_set: Vec<String>,
     },
 }
 
@@ -300,15 +304,22 @@ fn run(cli: Cli) -> Result<(), String> {
             let b = bar(n, "images");
             let stats = lab::eval_b::evaluate(&mut m, &data, &split, |_, _| b.inc(1))?;
             b.finish_and_clear();
-            let metrics = stats.metrics();
+            let report = lab::eval_b::Report {
+                ours: stats.ours.metrics(),
+                study_rule: stats.study.metrics(),
+            };
             println!(
                 "## Method B: {} on {} / {split}\n",
                 m.name(),
                 data.display()
             );
-            print!("{}", lab::eval_b::table(&metrics));
+            print!("{}", lab::eval_b::table(&report.ours));
+            println!(
+                "\nThe study's ruler (its label rule: boxes + 20 px wide, + 12 px tall on both sides, clamped):\n"
+            );
+            print!("{}", lab::eval_b::table(&report.study_rule));
             if let Some(p) = json {
-                let text = serde_json::to_string_pretty(&metrics).map_err(|e| e.to_string())?;
+                let text = serde_json::to_string_pretty(&report).map_err(|e| e.to_string())?;
                 std::fs::write(&p, text).map_err(|e| format!("{}: {e}", p.display()))?;
             }
         }
@@ -432,6 +443,7 @@ fn run(cli: Cli) -> Result<(), String> {
             dir,
             json,
             plot,
+            world_set,
         } => {
             use lab::world_eval::{EvalConfig, Family, evaluate, report};
             let umbra = match umbra {
@@ -464,6 +476,10 @@ fn run(cli: Cli) -> Result<(), String> {
                 world,
                 umbra,
                 dir,
+                world_set: world_set
+                    .iter()
+                    .map(|s| s.replacen('=', " = ", 1))
+                    .collect(),
             };
             let pb = bar(runs * cfg.families.len(), "runs");
             let out = evaluate(&cfg, |name| {

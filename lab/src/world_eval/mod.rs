@@ -53,6 +53,8 @@ pub struct EvalConfig {
     pub umbra: PathBuf,
     /// Where runs are written (and kept).
     pub dir: PathBuf,
+    /// Extra `[world]` lines for the world-on replays (`key = value`), for ablations.
+    pub world_set: Vec<String>,
 }
 
 /// One family × world setting's result.
@@ -94,6 +96,7 @@ pub fn replay(
     dir: &Path,
     run: &GeneratedRun,
     world: bool,
+    world_set: &[String],
 ) -> Result<Vec<Line>, String> {
     std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
     let write = |name: &str, bytes: &[u8]| {
@@ -106,7 +109,12 @@ pub fn replay(
     let config = write(
         if world { "world-on.toml" } else { "world-off.toml" },
         format!(
-            "# eval-world: no frame is skipped for time on a loaded host\n[runtime]\ndeadline_ms = 10000\n[world]\nenabled = {world}\n"
+            "# eval-world: no frame is skipped for time on a loaded host\n[runtime]\ndeadline_ms = 10000\n[world]\nenabled = {world}\n{}",
+            if world {
+                world_set.iter().map(|l| format!("{l}\n")).collect::<String>()
+            } else {
+                String::new()
+            }
         )
         .as_bytes(),
     )?;
@@ -169,7 +177,7 @@ pub fn evaluate(cfg: &EvalConfig, mut progress: impl FnMut(&str)) -> Result<Vec<
             std::fs::write(dir.join("truth.txt"), describe(&run.truth))
                 .map_err(|e| e.to_string())?;
             for o in &mut per {
-                let lines = replay(&cfg.umbra, &dir, &run, o.world)?;
+                let lines = replay(&cfg.umbra, &dir, &run, o.world, &cfg.world_set)?;
                 let on = if o.world { "on" } else { "off" };
                 picture::write(
                     &dir.join(format!("map-world-{on}.png")),

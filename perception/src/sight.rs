@@ -1,0 +1,56 @@
+//! What one revolution showed of a footprint in the map: hidden, in plain view, or seen empty
+//! (every ray across it returned from beyond). The world model's negative evidence. `no_std`.
+
+use crate::geometry::{Point2, Pose2};
+
+/// Bins of a revolution (1° each, counter-clockwise from the LiDAR's forward axis).
+pub const BINS: usize = 360;
+
+/// What a revolution showed of a footprint.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum View {
+    /// Out of range, inside the robot's own footprint, or behind something nearer.
+    Hidden,
+    /// In plain view: the rays reach it (they end inside its footprint).
+    Plain,
+    /// Seen empty: at least two rays cross it and every one that returned did so from beyond.
+    Empty,
+}
+
+/// What this revolution (`ranges`, from `lidar`) showed of a footprint of radius `r` m at
+/// `centre` (map frame); nothing beyond `max_range_m`.
+pub fn view(centre: Point2, r: f32, lidar: &Pose2, ranges: &[f32; BINS], max_range_m: f32) -> View {
+    let local = lidar.inverse().transform(centre);
+    let dist = libm::sqrtf(local.x * local.x + local.y * local.y);
+    if dist <= r || dist + r > max_range_m {
+        return View::Hidden;
+    }
+    let bearing = libm::atan2f(local.y, local.x).to_degrees();
+    let half = libm::asinf((r / dist).min(1.0)).to_degrees();
+    let (lo, hi) = (
+        libm::ceilf(bearing - half) as i32,
+        libm::floorf(bearing + half) as i32,
+    );
+    let (mut beyond, mut inside, mut before) = (0, 0, 0);
+    for d in lo..=hi {
+        let range = ranges[d.rem_euclid(BINS as i32) as usize];
+        if range <= 0.0 || !range.is_finite() {
+            continue; // no return: says nothing (dark surfaces drop out)
+        }
+        if range < dist - r {
+            before += 1;
+        } else if range < dist + r {
+            inside += 1;
+        } else {
+            beyond += 1;
+        }
+    }
+    if inside == 0 && before == 0 && beyond >= 2 {
+        View::Empty
+    } else if inside > 0 && inside >= before {
+        View::Plain
+    } else {
+        View::Hidden
+    }
+}
