@@ -6,7 +6,9 @@
 //!   segment's line (the study compares parallel segments only; without this, a corridor's
 //!   opposite walls 1 m apart would pass),
 //! - they do not overlap along that line, and the facing ends leave a gap of
-//!   `min_gap_m`–`max_gap_m` (0.9–1.4 m, the paper's numbers; its code used 1.3–2.0),
+//!   `min_gap_m`–`max_gap_m` (0.75–1.4 m; the paper's 0.9 m lower bound, its code's 1.3–2.0,
+//!   would miss standard interior doors, whose clear opening is 0.76–0.9 m: DIN 18101's
+//!   0.885 m leaf leaves ~0.8 m, the ADA asks for at least 0.815 m),
 //! - the gap is open: at most `max_occluders` cloud points lie in the triangle between the
 //!   sensor and the gap (more than `occluder_margin_m` in front of it). A gap that something in
 //!   front of the wall shadows is an occlusion, not a door.
@@ -47,7 +49,7 @@ impl Default for DoorConfig {
     fn default() -> Self {
         DoorConfig {
             max_angle_deg: 10.0,
-            min_gap_m: 0.9,
+            min_gap_m: 0.75,
             max_gap_m: 1.4,
             max_offset_m: 0.2,
             max_occluders: 3,

@@ -334,6 +334,11 @@ impl Tracks {
                 self.stats.rejected += 1;
             }
         }
+        // Where each track's walk would have taken it (once per frame, not per pair).
+        let mut ahead = [Point2::new(0.0, 0.0); MAX_TRACKS];
+        for (a, t) in ahead.iter_mut().zip(self.tracks.iter()) {
+            *a = t.motion.predict(stamp_s);
+        }
         // Greedy on the global minimum cost.
         loop {
             let mut best: Option<(f32, usize, usize)> = None;
@@ -346,10 +351,7 @@ impl Tracks {
                         continue;
                     }
                     // Looked for where it stands, or where its walk has taken it.
-                    let d = t
-                        .centre
-                        .distance(o.centre)
-                        .min(t.motion.predict(stamp_s).distance(o.centre));
+                    let d = t.centre.distance(o.centre).min(ahead[i].distance(o.centre));
                     // A desk's centre moves with the view more than a chair's (its legs
                     // come and go behind each other): desks gate at their own radius.
                     let desks = t.class() == ObjectClass::Desk && o.class == ObjectClass::Desk;

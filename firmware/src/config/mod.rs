@@ -58,7 +58,7 @@
 //! wall_aspect = 4.0
 //! corner_min_deg = 35.0
 //! door_max_angle_deg = 10.0
-//! door_min_gap_m = 0.9
+//! door_min_gap_m = 0.75
 //! door_max_gap_m = 1.4
 //! lidar_mount_x_m = -0.032     # LiDAR position on the robot (Burger)
 //!
