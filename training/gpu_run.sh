@@ -6,6 +6,13 @@
 #
 #   run(command="bash training/gpu_run.sh", carry=[".whl", ".gpu"], timeout_s=600)
 #
+# Before the call, here (both folders listed in .git/info/exclude):
+#   python3 -m pip download --no-deps --only-binary=:all: --python-version 3.12 \
+#       --implementation cp --platform manylinux_2_28_x86_64 -d .whl \
+#       ultralytics==8.4.190 ultralytics-thop
+#   cargo build --release -p umbra-sim && mkdir -p .gpu && cp target/release/umbra-sim .gpu/
+# The machine's own torch (2.11) and numpy, opencv, polars-free Ultralytics paths are used.
+#
 # Knobs (environment): SCENARIOS (16000), SEED (35; never an eval or test seed), HOURS (0.11),
 # BATCH (128), LR0 (0.0005), WORKERS (14), DEVICE (0), PY (python3), NAME (gpu19), LIMIT (560:
 # seconds from the start after which training is interrupted, so the weights saved at the last
