@@ -68,7 +68,7 @@ impl ObjectOut {
     /// A confirmed track of the world model: its stable id, its most likely class, and a
     /// score that is the belief it exists times the class's share of the evidence.
     pub fn track(t: &Track) -> Self {
-        let exists = 1.0 / (1.0 + (-f64::from(t.existence)).exp());
+        let exists = belief(t);
         ObjectOut {
             id: t.id,
             class: t.class(),
@@ -81,6 +81,11 @@ impl ObjectOut {
             last_seen: Some(t.last_seen),
         }
     }
+}
+
+/// A track's existence as a probability in (0, 1) (the logistic of its log-odds).
+fn belief(t: &Track) -> f64 {
+    1.0 / (1.0 + (-f64::from(t.existence)).exp())
 }
 
 /// The wire name of a class (`perception::class`'s names are the contract's).
@@ -145,7 +150,7 @@ impl PersonOut {
             y: f64::from(t.centre.y),
             vx: f64::from(t.motion.vel.x),
             vy: f64::from(t.motion.vel.y),
-            score: 1.0 / (1.0 + (-f64::from(t.existence)).exp()),
+            score: belief(t),
         }
     }
 }

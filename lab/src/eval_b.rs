@@ -466,6 +466,7 @@ pub fn evaluate(
     }
     let mut stats = Scored::default();
     let mut wide: Vec<Detection> = Vec::with_capacity(300);
+    let mut wide_truth: Vec<TrueBox> = Vec::new();
     let mut scratch = DecodeScratch::new();
     let mut dets: heapless::Vec<Detection, 300> = heapless::Vec::new();
     for (n, img) in images.iter().enumerate() {
@@ -489,7 +490,8 @@ pub fn evaluate(
             .map_err(|e| e.to_string())?
             .map_err(|e| e.to_string())?;
         stats.ours.add_image(&truth, &dets);
-        let wide_truth: Vec<TrueBox> = truth.iter().map(|&(c, b)| (c, study_box(b))).collect();
+        wide_truth.clear();
+        wide_truth.extend(truth.iter().map(|&(c, b)| (c, study_box(b))));
         wide.clear();
         wide.extend(dets.iter().map(study_detection));
         stats.study.add_image(&wide_truth, &wide);

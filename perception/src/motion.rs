@@ -103,11 +103,11 @@ impl Motion {
         }
     }
 
-    /// Where it is expected at `stamp_s` (the velocity carried forward; a long gap or a
-    /// non-finite time carries nothing).
-    pub fn predict(&self, stamp_s: f64) -> Point2 {
+    /// Where it is expected at `stamp_s` (the velocity carried forward; a gap over
+    /// [`MotionConfig::max_gap_s`] or a non-finite time carries nothing).
+    pub fn predict(&self, stamp_s: f64, cfg: &MotionConfig) -> Point2 {
         let dt = (stamp_s - self.stamp_s) as f32;
-        if !(dt > 0.0 && dt.is_finite()) || dt > 1.0 {
+        if !(dt > 0.0 && dt.is_finite()) || dt > cfg.max_gap_s {
             return self.pos;
         }
         Point2::new(self.pos.x + self.vel.x * dt, self.pos.y + self.vel.y * dt)
@@ -198,7 +198,7 @@ mod test {
         assert!(m.moving);
         assert!((m.vel.x - 0.8).abs() < 0.3, "vx {}", m.vel.x);
         assert!(m.vel.y.abs() < 0.1);
-        let ahead = m.predict(2.2);
+        let ahead = m.predict(2.2, &cfg);
         assert!(ahead.x > m.pos.x);
     }
 
@@ -241,6 +241,6 @@ mod test {
         // A jump of 100 m in 0.2 s: the velocity is clamped to a walk.
         m.observe(Point2::new(100.0, 0.0), 5.4, &cfg, true);
         assert!(m.speed() <= cfg.max_speed + 1e-3);
-        assert_eq!(m.predict(f64::NAN), m.pos);
+        assert_eq!(m.predict(f64::NAN, &cfg), m.pos);
     }
 }

@@ -164,11 +164,6 @@ impl Track {
         }
     }
 
-    /// A walking person's legs (never furniture): see [`crate::motion`].
-    pub fn moving(&self) -> bool {
-        self.motion.moving
-    }
-
     /// Which methods have seen it.
     pub fn evidence(&self) -> Evidence {
         match (self.seen_a, self.seen_b) {
@@ -337,7 +332,7 @@ impl Tracks {
         // Where each track's walk would have taken it (once per frame, not per pair).
         let mut ahead = [Point2::new(0.0, 0.0); MAX_TRACKS];
         for (a, t) in ahead.iter_mut().zip(self.tracks.iter()) {
-            *a = t.motion.predict(stamp_s);
+            *a = t.motion.predict(stamp_s, &cfg.motion);
         }
         // Greedy on the global minimum cost.
         loop {
