@@ -127,9 +127,9 @@ pub struct Score {
     pub observable: [u32; 3],
     /// Furniture present per class (observable or not).
     pub present: [u32; 3],
-    /// Clutter items by kind (bin, pillar, legs) and what they were labelled as (chair, box,
+    /// Clutter items by kind (`CLUTTER_KINDS`) and what they were labelled as (chair, box,
     /// desk, not reported).
-    pub clutter: [[u32; 4]; 3],
+    pub clutter: [[u32; 4]; CLUTTER_KINDS.len()],
     /// Views with an observable door: (correct, total).
     pub door_views: (u32, u32),
     /// Views without one: (correct, total).
@@ -154,7 +154,15 @@ pub(crate) fn class_index(c: ObjectClass) -> Option<usize> {
     }
 }
 
-const CLUTTER_KINDS: [&str; 3] = ["bin", "pillar", "legs"];
+/// Clutter kinds of the simulator: the study's three, then a varied world's.
+const CLUTTER_KINDS: [&str; 6] = [
+    "bin",
+    "pillar",
+    "legs",
+    "shelf",
+    "radiator",
+    "square pillar",
+];
 
 impl Score {
     /// Scores one view.

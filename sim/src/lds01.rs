@@ -77,6 +77,26 @@ impl Lds01SimConfig {
     }
 }
 
+impl Lds01SimConfig {
+    /// This LiDAR as one unit of a varied world sees it (`WorldConfig::varied`): a dirtier
+    /// window or a weaker unit reaches less far (strong returns to 2.6–3.5 m, a few to 0.3–1 m
+    /// beyond), and drops out more or less on dark and grazing surfaces; drawn from `seed`.
+    pub fn varied(&self, seed: u64) -> Self {
+        let mut rng = ChaCha8Rng::seed_from_u64(seed);
+        let spec_max_m = rng.random_range(2.6..3.5f32);
+        Lds01SimConfig {
+            dropout: rng.random_range(0.02..0.08),
+            dark_dropout: rng.random_range(0.1..0.5),
+            glancing_dropout: rng.random_range(0.3..0.9),
+            spec_max_m,
+            far_return: rng.random_range(0.05..0.4),
+            far_max_m: spec_max_m + rng.random_range(0.3..1.0f32),
+            noise_frac: rng.random_range(0.015..0.035),
+            ..self.clone()
+        }
+    }
+}
+
 /// The reading model with its own random stream.
 #[derive(Debug, Clone)]
 pub struct LidarModel {
@@ -228,6 +248,20 @@ mod test {
     use super::*;
     use crate::robot::{Motion, RobotConfig};
     use drivers::lds01::{Lds01Config, Lds01Stream};
+
+    #[test]
+    fn a_varied_unit_reaches_less_far_and_is_reproducible() {
+        let base = Lds01SimConfig::default();
+        for seed in 0..50 {
+            let v = base.varied(seed);
+            assert_eq!(v, base.varied(seed));
+            assert!((2.6..3.5).contains(&v.spec_max_m), "{v:?}");
+            assert!(v.far_max_m > v.spec_max_m && v.far_max_m <= v.spec_max_m + 1.0);
+            assert!(v.dropout < v.dark_dropout && v.far_return < 0.4);
+            assert_eq!(v.rpm, base.rpm);
+        }
+        assert_ne!(base.varied(1), base.varied(2));
+    }
     use drivers::lidar::RevolutionStream as _;
     use perception::geometry::Point2;
 

@@ -154,7 +154,13 @@ impl Scenario {
         let mut seeds = ChaCha8Rng::seed_from_u64(seed);
         let robot = Robot::new(&world, cfg.robot, seeds.random());
         let compass = Compass::new(&world, cfg.compass, seeds.random());
-        let lidar = LidarModel::new(cfg.lidar.clone(), seeds.random());
+        let lidar_seed = seeds.random();
+        let lidar_cfg = if world.varied {
+            cfg.lidar.varied(seeds.random())
+        } else {
+            cfg.lidar.clone()
+        };
+        let lidar = LidarModel::new(lidar_cfg, lidar_seed);
         Scenario {
             start_pose: robot.pose,
             world,

@@ -73,6 +73,8 @@ enum Command {
         scenes: usize,
         #[arg(long, value_enum, default_value = "odometry")]
         pose: Pose,
+        #[command(flatten)]
+        worlds: Worlds,
     },
     /// Trains the forest and writes its tables.
     ForestTrain {
@@ -99,6 +101,8 @@ enum Command {
         scenes: usize,
         #[arg(long, value_enum, default_value = "odometry")]
         pose: Pose,
+        #[command(flatten)]
+        worlds: Worlds,
         /// Write the confusion matrix here (PNG).
         #[arg(long)]
         confusion: Option<PathBuf>,
@@ -209,9 +213,25 @@ fn feature_frame(object: bool) -> FeatureFrame {
     }
 }
 
-fn scene_cfg(seed: u64, pose: Pose) -> SceneConfig {
+/// Which simulator worlds a Method A command runs on.
+#[derive(clap::Args, Clone, Copy)]
+struct Worlds {
+    /// Most clutter items per scene.
+    #[arg(long, default_value_t = 3)]
+    clutter: usize,
+    /// Share of worlds drawn varied (`umbra-sim dataset --varied`).
+    #[arg(long, default_value_t = 0.0)]
+    varied: f64,
+}
+
+fn scene_cfg(seed: u64, pose: Pose, worlds: Worlds) -> SceneConfig {
     SceneConfig {
         seed,
+        world: sim::world::WorldConfig {
+            max_clutter: worlds.clutter,
+            varied: worlds.varied,
+            ..sim::world::WorldConfig::default()
+        },
         pose: match pose {
             Pose::Odometry => PoseSource::Odometry,
             Pose::Truth => PoseSource::Truth,
@@ -227,8 +247,9 @@ fn run(cli: Cli) -> Result<(), String> {
             seed,
             scenes,
             pose,
+            worlds,
         } => {
-            let cfg = scene_cfg(seed, pose);
+            let cfg = scene_cfg(seed, pose, worlds);
             let mut method = Box::new(MethodA::new());
             let mut text = csv_header();
             text.push('\n');
@@ -327,12 +348,13 @@ fn run(cli: Cli) -> Result<(), String> {
             seed,
             scenes,
             pose,
+            worlds,
             confusion,
             compare_frames,
             merge_guards,
             data,
         } => {
-            let cfg = scene_cfg(seed, pose);
+            let cfg = scene_cfg(seed, pose, worlds);
             let forest = models::forest::forest();
             let acfg = MethodAConfig {
                 frame: feature_frame(forest.object_frame),

@@ -1,6 +1,6 @@
 //! `umbra-sim`: the simulator's command line.
 //!
-//! * `umbra-sim dataset --out DIR [--scenarios 50] [--frames 200] [--seed 1] [--kinds rect,lshape,tworooms] [--clutter 3] [--test-only]`
+//! * `umbra-sim dataset --out DIR [--scenarios 50] [--frames 200] [--seed 1] [--kinds rect,lshape,tworooms] [--clutter 3] [--varied 0.5] [--test-only]`
 //!   writes the datasets of `sim::dataset` with a progress bar.
 //! * `umbra-sim speed [--scenarios 16] [--frames 200]` measures labelled frames per second
 //!   with rasters and labels built in memory.
@@ -59,6 +59,11 @@ enum Command {
         /// Most clutter items per scene.
         #[arg(long, default_value_t = 3)]
         clutter: usize,
+        /// Share of worlds drawn varied (0–1): other wall thicknesses and colours, doorways at
+        /// corners, door leaves, partition stubs, furniture against walls, tucked chairs,
+        /// shelves, radiators, square pillars, a LiDAR that reaches less far.
+        #[arg(long, default_value_t = 0.0)]
+        varied: f64,
         /// Skip Method B images and labels.
         #[arg(long)]
         no_images: bool,
@@ -155,6 +160,7 @@ fn run(command: Command) -> Result<(), String> {
             seed,
             kinds: k,
             clutter,
+            varied,
             no_images,
             no_method_a,
             no_recordings,
@@ -168,6 +174,7 @@ fn run(command: Command) -> Result<(), String> {
                 world: WorldConfig {
                     kinds: kinds(&k),
                     max_clutter: clutter,
+                    varied,
                     ..WorldConfig::default()
                 },
                 method_b: !no_images,

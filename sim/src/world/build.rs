@@ -6,7 +6,7 @@ use perception::geometry::Point2;
 use rand::Rng;
 use rand_chacha::ChaCha8Rng;
 
-use super::{CLEARANCE, ClutterTruth, DoorTruth, ObjectTruth, Prim, Shape, Surface, WALL_T};
+use super::{CLEARANCE, ClutterTruth, DoorTruth, ObjectTruth, Prim, Shape, Surface};
 
 pub(super) fn rect_corners(c: Point2, half: (f32, f32), yaw: f32) -> [Point2; 4] {
     let (s, co) = yaw.sin_cos();
@@ -28,6 +28,10 @@ pub(super) struct Builder {
     pub(super) floor: Vec<(Point2, Point2)>,
     /// Keep-out discs (centre, radius) of everything placed so far, for spacing.
     pub(super) keep_out: Vec<(Point2, f32)>,
+    /// Wall thickness, metres ([`super::WALL_T`] unless the world is varied).
+    pub(super) wall_t: f32,
+    /// Drawn with the wider variety (`variety.rs`).
+    pub(super) varied: bool,
 }
 
 impl Builder {
@@ -69,10 +73,15 @@ impl Builder {
     }
 
     pub(super) fn wall_reflectivity(&mut self) -> f32 {
-        self.rng.random_range(0.75..1.0)
+        if self.varied {
+            // Dark paint, glass-fronted cabinets, wood panelling: anything from 0.12 up.
+            self.rng.random_range(0.12..1.0)
+        } else {
+            self.rng.random_range(0.75..1.0)
+        }
     }
 
-    /// A straight wall of thickness `WALL_T` from `p` to `q` (axis-aligned), built on the side
+    /// A straight wall of thickness `wall_t` from `p` to `q` (axis-aligned), built on the side
     /// `outward` (unit normal), with an optional doorway gap `[g0, g1]` measured from `p`.
     pub(super) fn wall(&mut self, p: Point2, q: Point2, outward: Point2, gap: Option<(f32, f32)>) {
         let refl = self.wall_reflectivity();
@@ -82,7 +91,7 @@ impl Builder {
         let piece = |b: &mut Builder, t0: f32, t1: f32| {
             let a = along(t0);
             let c = along(t1);
-            let a2 = Point2::new(c.x + outward.x * WALL_T, c.y + outward.y * WALL_T);
+            let a2 = Point2::new(c.x + outward.x * b.wall_t, c.y + outward.y * b.wall_t);
             let min = Point2::new(a.x.min(a2.x), a.y.min(a2.y));
             let max = Point2::new(a.x.max(a2.x), a.y.max(a2.y));
             b.aabb(min, max, Surface::Wall, refl);
@@ -102,11 +111,12 @@ impl Builder {
         let id = self.doors.len() as u16;
         let refl = self.rng.random_range(0.5..0.95);
         let jamb_w = 0.04;
+        let wall_t = self.wall_t;
         let reveal = 0.02; // the frame stands proud of the wall on both sides
         let mk = |at: Point2, sign: f32| -> [Point2; 4] {
             // From the gap edge `at`, the jamb extends `jamb_w` into the wall side (sign).
             let o0 = -reveal;
-            let o1 = WALL_T + reveal;
+            let o1 = wall_t + reveal;
             let p = |s: f32, o: f32| {
                 Point2::new(
                     at.x + dir.x * s * sign + outward.x * o,
@@ -121,11 +131,11 @@ impl Builder {
         self.polygon(&right, Surface::DoorFrame(id), refl);
         let width = a.distance(b);
         let centre = Point2::new(
-            (a.x + b.x) / 2.0 + outward.x * WALL_T / 2.0,
-            (a.y + b.y) / 2.0 + outward.y * WALL_T / 2.0,
+            (a.x + b.x) / 2.0 + outward.x * wall_t / 2.0,
+            (a.y + b.y) / 2.0 + outward.y * wall_t / 2.0,
         );
         let half_len = width / 2.0 + jamb_w;
-        let half_t = WALL_T / 2.0 + reveal;
+        let half_t = wall_t / 2.0 + reveal;
         let wall_angle = dir.y.atan2(dir.x);
         self.doors.push(DoorTruth {
             centre,
@@ -134,6 +144,9 @@ impl Builder {
             footprint: rect_corners(centre, (half_len, half_t), wall_angle),
         });
         self.keep_out.push((centre, half_len));
+        if self.varied && self.rng.random_bool(0.4) {
+            self.door_leaf(a, b, dir, outward);
+        }
     }
 
     /// Walls around an axis-aligned rectilinear outline (counter-clockwise), with a doorway in
@@ -156,19 +169,21 @@ impl Builder {
                 (b.x - a.x) * (c.y - b.y) - (b.y - a.y) * (c.x - b.x) > 0.0
             };
             let ext0 = if convex(v[(i + n - 1) % n], p, q) {
-                WALL_T
+                self.wall_t
             } else {
                 0.0
             };
             let ext1 = if convex(p, q, v[(i + 2) % n]) {
-                WALL_T
+                self.wall_t
             } else {
                 0.0
             };
             let p2 = Point2::new(p.x - dir.x * ext0, p.y - dir.y * ext0);
             let q2 = Point2::new(q.x + dir.x * ext1, q.y + dir.y * ext1);
             let gap = door.filter(|(e, _)| *e == i).map(|(_, w)| {
-                let g0 = self.rng.random_range(0.3..(len - w - 0.3).max(0.31)) + ext0;
+                // Varied worlds put doorways up to a corner (a 5 cm stub of wall beside it).
+                let m = if self.varied { 0.05 } else { 0.3 };
+                let g0 = self.rng.random_range(m..(len - w - m).max(m + 0.01)) + ext0;
                 door_out = Some((
                     Point2::new(p2.x + dir.x * (g0 + w / 2.0), p2.y + dir.y * (g0 + w / 2.0)),
                     dir,
@@ -189,9 +204,29 @@ impl Builder {
             door_centre.x + outward.x * dist,
             door_centre.y + outward.y * dist,
         );
-        let p = Point2::new(c.x - dir.x * half, c.y - dir.y * half);
-        let q = Point2::new(c.x + dir.x * half, c.y + dir.y * half);
-        self.wall(p, q, outward, None);
+        // Shortened where it would cut into the room (beyond a doorway in an L's notch).
+        let mut half: f32 = half;
+        loop {
+            let p = Point2::new(c.x - dir.x * half, c.y - dir.y * half);
+            let q = Point2::new(c.x + dir.x * half, c.y + dir.y * half);
+            let far = Point2::new(q.x + outward.x * self.wall_t, q.y + outward.y * self.wall_t);
+            let (min, max) = (
+                Point2::new(p.x.min(far.x), p.y.min(far.y)),
+                Point2::new(p.x.max(far.x), p.y.max(far.y)),
+            );
+            let cuts = self
+                .floor
+                .iter()
+                .any(|(lo, hi)| min.x < hi.x && max.x > lo.x && min.y < hi.y && max.y > lo.y);
+            if !cuts {
+                self.wall(p, q, outward, None);
+                return;
+            }
+            if half < 0.8 {
+                return;
+            }
+            half -= 0.1;
+        }
     }
 
     pub(super) fn fits(&self, c: Point2, r: f32, gap: f32) -> bool {
@@ -230,13 +265,58 @@ impl Builder {
         )
     }
 
-    pub(super) fn furniture(&mut self, class: ObjectClass) -> bool {
+    /// The half-size and leg radius (`None`: solid) of a new piece of `class`, scaled by
+    /// U(0.8, 1.2); `None` for classes that are not furniture.
+    pub(super) fn piece_shape(&mut self, class: ObjectClass) -> Option<((f32, f32), Option<f32>)> {
         let scale = self.rng.random_range(0.8..1.2f32);
-        let (half, leg) = match class {
-            ObjectClass::Chair => ((0.2 * scale, 0.2 * scale), Some(0.015 * scale)),
-            ObjectClass::Desk => ((0.8 * scale, 0.4 * scale), Some(0.025 * scale)),
-            ObjectClass::Box => ((0.3 * scale, 0.2 * scale), None),
-            ObjectClass::DoorFrame => return false,
+        match class {
+            ObjectClass::Chair => Some(((0.2 * scale, 0.2 * scale), Some(0.015 * scale))),
+            ObjectClass::Desk => Some(((0.8 * scale, 0.4 * scale), Some(0.025 * scale))),
+            ObjectClass::Box => Some(((0.3 * scale, 0.2 * scale), None)),
+            ObjectClass::DoorFrame => None,
+        }
+    }
+
+    /// Builds a piece of `class` at `c` turned by `yaw`, records its truth and keep-out disc.
+    pub(super) fn put(
+        &mut self,
+        class: ObjectClass,
+        c: Point2,
+        yaw: f32,
+        half: (f32, f32),
+        leg: Option<f32>,
+    ) {
+        let id = Surface::Object(self.objects.len() as u16);
+        let footprint = rect_corners(c, half, yaw);
+        match leg {
+            Some(r) => {
+                let refl = match class {
+                    ObjectClass::Desk => self.rng.random_range(0.25..0.7),
+                    _ => self.rng.random_range(0.35..0.9),
+                };
+                for leg_c in rect_corners(c, (half.0 - r, half.1 - r), yaw) {
+                    self.circle(leg_c, r, id, refl);
+                }
+            }
+            None => {
+                let refl = self.rng.random_range(0.55..0.9);
+                self.polygon(&footprint, id, refl);
+            }
+        }
+        self.objects.push(ObjectTruth {
+            class,
+            centre: c,
+            yaw,
+            footprint,
+        });
+        self.keep_out
+            .push((c, (half.0 * half.0 + half.1 * half.1).sqrt()));
+    }
+
+    /// A piece of `class` anywhere on the floor, [`CLEARANCE`] from everything else.
+    pub(super) fn furniture(&mut self, class: ObjectClass) -> bool {
+        let Some((half, leg)) = self.piece_shape(class) else {
+            return false;
         };
         let radius = (half.0 * half.0 + half.1 * half.1).sqrt();
         for _ in 0..60 {
@@ -247,30 +327,7 @@ impl Builder {
             let yaw = self
                 .rng
                 .random_range(-core::f32::consts::PI..core::f32::consts::PI);
-            let id = Surface::Object(self.objects.len() as u16);
-            let footprint = rect_corners(c, half, yaw);
-            match leg {
-                Some(r) => {
-                    let refl = match class {
-                        ObjectClass::Desk => self.rng.random_range(0.25..0.7),
-                        _ => self.rng.random_range(0.35..0.9),
-                    };
-                    for leg_c in rect_corners(c, (half.0 - r, half.1 - r), yaw) {
-                        self.circle(leg_c, r, id, refl);
-                    }
-                }
-                None => {
-                    let refl = self.rng.random_range(0.55..0.9);
-                    self.polygon(&footprint, id, refl);
-                }
-            }
-            self.objects.push(ObjectTruth {
-                class,
-                centre: c,
-                yaw,
-                footprint,
-            });
-            self.keep_out.push((c, radius));
+            self.put(class, c, yaw, half, leg);
             return true;
         }
         false

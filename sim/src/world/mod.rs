@@ -21,6 +21,7 @@ use rand_chacha::ChaCha8Rng;
 
 mod build;
 pub mod grid;
+mod variety;
 use build::{Builder, inside};
 use grid::Grid;
 
@@ -211,6 +212,12 @@ pub struct WorldConfig {
     pub door_chance: f64,
     /// Clutter items: drawn uniformly from 0..=max.
     pub max_clutter: usize,
+    /// Chance that a world is drawn *varied* ([`World::varied`], `variety.rs`): walls 0.05–0.25 m
+    /// thick of any reflectivity, doorways from 0.75 m and up to corners, open door leaves,
+    /// partition stubs, furniture against walls and chairs tucked at desks, shelves and square
+    /// pillars, and a LiDAR whose reach and dropouts vary. 0 (the default) draws nothing extra,
+    /// so the worlds of every seed are the ones they always were.
+    pub varied: f64,
 }
 
 impl Default for WorldConfig {
@@ -220,6 +227,7 @@ impl Default for WorldConfig {
             furniture_density: 0.2,
             door_chance: 0.8,
             max_clutter: 3,
+            varied: 0.0,
         }
     }
 }
@@ -243,19 +251,36 @@ pub struct World {
     pub robot_start: Point2,
     /// Spatial index over `prims`.
     pub grid: Grid,
+    /// Drawn with the wider variety of [`WorldConfig::varied`].
+    pub varied: bool,
 }
 
 impl World {
     /// A random world from `seed`.
     pub fn generate(seed: u64, cfg: &WorldConfig) -> World {
+        let mut rng = ChaCha8Rng::seed_from_u64(seed);
+        // Drawn only when asked for, so that `varied: 0` leaves every seed's world unchanged.
+        let varied = cfg.varied > 0.0 && rng.random_bool(cfg.varied.min(1.0));
+        let wall_t = if varied {
+            rng.random_range(0.05..0.25)
+        } else {
+            WALL_T
+        };
         let mut b = Builder {
-            rng: ChaCha8Rng::seed_from_u64(seed),
+            rng,
             prims: Vec::new(),
             objects: Vec::new(),
             doors: Vec::new(),
             clutter: Vec::new(),
             floor: Vec::new(),
             keep_out: Vec::new(),
+            wall_t,
+            varied,
+        };
+        let door_min = if varied {
+            variety::DOOR_WIDTH_MIN
+        } else {
+            DOOR_WIDTH_MIN
         };
         let kinds = if cfg.kinds.is_empty() {
             vec![RoomKind::Rect]
@@ -266,8 +291,10 @@ impl World {
         let p = Point2::new;
         match kind {
             RoomKind::Rect | RoomKind::LShape => {
-                let w = b.rng.random_range(3.0..8.0f32);
-                let h = b.rng.random_range(3.0..8.0f32);
+                // Varied worlds: rooms up to 11 m, larger than the LiDAR reaches.
+                let side = if varied { 11.0 } else { 8.0 };
+                let w = b.rng.random_range(3.0..side);
+                let h = b.rng.random_range(3.0..side);
                 let outline: Vec<Point2> = if kind == RoomKind::Rect {
                     b.floor.push((p(0.0, 0.0), p(w, h)));
                     vec![p(0.0, 0.0), p(w, 0.0), p(w, h), p(0.0, h)]
@@ -286,7 +313,7 @@ impl World {
                     ]
                 };
                 let door = b.rng.random_bool(cfg.door_chance).then(|| {
-                    let width = b.rng.random_range(DOOR_WIDTH_MIN..DOOR_WIDTH_MAX);
+                    let width = b.rng.random_range(door_min..DOOR_WIDTH_MAX);
                     // A doorway on an edge long enough for it.
                     let n = outline.len();
                     let mut e = b.rng.random_range(0..n);
@@ -330,14 +357,15 @@ impl World {
                 ];
                 b.outline(&outline, None);
                 // Doorways: walls across the corridor at both ends, each with a gap.
-                for x in [w1, x2 - WALL_T] {
-                    let width = b
-                        .rng
-                        .random_range(DOOR_WIDTH_MIN..(cw - 0.2).min(DOOR_WIDTH_MAX));
+                for x in [w1, x2 - b.wall_t] {
+                    let width = b.rng.random_range(door_min..(cw - 0.2).min(DOOR_WIDTH_MAX));
                     let g0 = b.rng.random_range(0.05..(cw - width - 0.05));
                     b.wall(p(x, yc), p(x, yc + cw), p(1.0, 0.0), Some((g0, g0 + width)));
                 }
             }
+        }
+        if varied {
+            b.stubs();
         }
         let area: f32 = b.floor.iter().map(|(a, c)| (c.x - a.x) * (c.y - a.y)).sum();
         let n = ((area * cfg.furniture_density).round() as usize).max(2);
@@ -355,11 +383,19 @@ impl World {
                 (_, 1) => ObjectClass::Box,
                 _ => ObjectClass::Desk,
             };
-            b.furniture(class);
+            if varied {
+                b.furniture_varied(class);
+            } else {
+                b.furniture(class);
+            }
         }
         let n_clutter = b.rng.random_range(0..=cfg.max_clutter);
         for _ in 0..n_clutter {
-            b.clutter_item();
+            if varied {
+                b.clutter_varied();
+            } else {
+                b.clutter_item();
+            }
         }
         let grid = Grid::build(&b.prims);
         let mut world = World {
@@ -371,6 +407,7 @@ impl World {
             floor: b.floor,
             robot_start: Point2::default(),
             grid,
+            varied,
         };
         let mut rng = ChaCha8Rng::seed_from_u64(seed ^ 0x0b07);
         world.robot_start = world.free_point(&mut rng, 0.6).unwrap_or_else(|| {

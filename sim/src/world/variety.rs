@@ -1,0 +1,449 @@
+//! What a *varied* world ([`super::WorldConfig::varied`]) adds to the study's world: the wall
+//! geometry and the clutter that a detector trained on the study's rooms alone mistakes for
+//! furniture, and furniture where rooms really keep it.
+//!
+//! * doorways from [`DOOR_WIDTH_MIN`] (door standards: a DIN 18101 0.885 m leaf leaves about
+//!   0.8 m clear) and up to a corner; open door leaves (a thin panel hinged on a jamb);
+//! * partition stubs: short walls standing into the room, whose ends a scan sees as a blob;
+//! * furniture against walls (desks long side to the wall; chairs and boxes either way), and
+//!   chairs tucked at desks (part under the desk's edge, or just pulled out);
+//! * clutter that hugs walls (shelves, radiators) and square pillars (free or as a pilaster),
+//!   besides the study's bins, round pillars and standing legs.
+//!
+//! Wall thickness (0.05–0.25 m) and reflectivity (0.12–1.0) are drawn in `build.rs`; the
+//! LiDAR's reach and dropouts in `Lds01SimConfig::varied`. Everything here draws from the
+//! world's own random stream, so a varied world is as reproducible as any other.
+
+use core::f32::consts::{FRAC_PI_2, PI};
+
+use perception::class::ObjectClass;
+use perception::geometry::Point2;
+use rand::Rng;
+
+use super::build::{Builder, rect_corners};
+use super::{CLEARANCE, ClutterTruth, Surface};
+
+/// Narrowest doorway of a varied world, metres.
+pub const DOOR_WIDTH_MIN: f32 = 0.75;
+
+/// Space kept between a wall-side piece and everything else, metres.
+const WALL_SIDE_GAP: f32 = 0.35;
+
+/// A spot against a wall: the centre and yaw of a rectangle with half-sizes `half` whose
+/// `half.0` side runs along the wall (or across it when `across`), `0..gap_max` m off the
+/// wall's face.
+struct WallSpot {
+    centre: Point2,
+    yaw: f32,
+    /// The wall's inward normal (into the room).
+    inward: Point2,
+}
+
+impl Builder {
+    /// `true` if `p` is strictly inside a floor rectangle.
+    fn on_floor(&self, p: Point2) -> bool {
+        self.floor
+            .iter()
+            .any(|(lo, hi)| p.x > lo.x && p.x < hi.x && p.y > lo.y && p.y < hi.y)
+    }
+
+    /// Finds a place against a real wall (not the open side between two floor rectangles)
+    /// for a rectangle of half-sizes `half`, clear of everything placed by `spacing`.
+    fn wall_spot(
+        &mut self,
+        half: (f32, f32),
+        across: bool,
+        gap_max: f32,
+        spacing: f32,
+    ) -> Option<WallSpot> {
+        let (hw, hn) = if across { (half.1, half.0) } else { half };
+        let radius = (half.0 * half.0 + half.1 * half.1).sqrt();
+        for _ in 0..30 {
+            let (lo, hi) = self.floor[self.rng.random_range(0..self.floor.len())];
+            let side = self.rng.random_range(0..4u8);
+            // The wall's face point at `t`, its inward normal, and the run of `t`.
+            let (origin, along, inward, run) = match side {
+                0 => (
+                    lo,
+                    Point2::new(1.0, 0.0),
+                    Point2::new(0.0, 1.0),
+                    hi.x - lo.x,
+                ),
+                1 => (
+                    Point2::new(hi.x, lo.y),
+                    Point2::new(0.0, 1.0),
+                    Point2::new(-1.0, 0.0),
+                    hi.y - lo.y,
+                ),
+                2 => (
+                    Point2::new(lo.x, hi.y),
+                    Point2::new(1.0, 0.0),
+                    Point2::new(0.0, -1.0),
+                    hi.x - lo.x,
+                ),
+                _ => (
+                    lo,
+                    Point2::new(0.0, 1.0),
+                    Point2::new(1.0, 0.0),
+                    hi.y - lo.y,
+                ),
+            };
+            if run < 2.0 * hw + 0.2 {
+                continue;
+            }
+            let t = self.rng.random_range(hw + 0.1..run - hw - 0.1);
+            let jitter = self.rng.random_range(-0.04..0.04f32);
+            let off = hn + self.rng.random_range(0.01..gap_max.max(0.011)) + jitter.abs() * hw;
+            let at = |s: f32, n: f32| {
+                Point2::new(
+                    origin.x + along.x * s + inward.x * n,
+                    origin.y + along.y * s + inward.y * n,
+                )
+            };
+            // A wall behind the whole piece: just beyond the face is off the floor.
+            if [t - hw, t, t + hw]
+                .iter()
+                .any(|&s| self.on_floor(at(s, -0.05)))
+            {
+                continue;
+            }
+            let centre = at(t, off);
+            if !self
+                .keep_out
+                .iter()
+                .all(|(o, or)| centre.distance(*o) >= radius + or + spacing)
+            {
+                continue;
+            }
+            let wall_dir =
+                along.y.atan2(along.x) + if self.rng.random_bool(0.5) { PI } else { 0.0 };
+            let yaw = wall_dir + if across { FRAC_PI_2 } else { 0.0 } + jitter;
+            return Some(WallSpot {
+                centre,
+                yaw,
+                inward,
+            });
+        }
+        None
+    }
+
+    /// A piece of `class` in a varied world: against a wall 45 % of the time (else, or if no
+    /// wall has room, anywhere), and a desk gets a chair tucked at it half the time.
+    pub(super) fn furniture_varied(&mut self, class: ObjectClass) -> bool {
+        let placed =
+            (self.rng.random_bool(0.45) && self.against_wall(class)) || self.furniture(class);
+        if placed && class == ObjectClass::Desk && self.rng.random_bool(0.5) {
+            self.tucked_chair();
+        }
+        placed
+    }
+
+    /// A piece of `class` 1–8 cm off a wall.
+    fn against_wall(&mut self, class: ObjectClass) -> bool {
+        let Some((half, leg)) = self.piece_shape(class) else {
+            return false;
+        };
+        let across = class != ObjectClass::Desk && self.rng.random_bool(0.4);
+        match self.wall_spot(half, across, 0.08, WALL_SIDE_GAP) {
+            Some(s) => {
+                self.put(class, s.centre, s.yaw, half, leg);
+                true
+            }
+            None => false,
+        }
+    }
+
+    /// A chair at the last desk placed: from a third under its edge to a little pulled out,
+    /// on a side with floor, clear of the desk's legs.
+    fn tucked_chair(&mut self) {
+        let Some(desk) = self.objects.last().cloned() else {
+            return;
+        };
+        let Some((ch, leg)) = self.piece_shape(ObjectClass::Chair) else {
+            return;
+        };
+        let fp = desk.footprint;
+        let (hx, hy) = (fp[0].distance(fp[1]) / 2.0, fp[1].distance(fp[2]) / 2.0);
+        let (s, c) = desk.yaw.sin_cos();
+        let reach = hx - ch.0 - 0.15;
+        if reach <= 0.0 {
+            return;
+        }
+        let u = self.rng.random_range(-reach..reach);
+        let f = self.rng.random_range(-0.3..1.4f32);
+        let yaw = desk.yaw + self.rng.random_range(-0.25..0.25f32);
+        let first = if self.rng.random_bool(0.5) { 1.0 } else { -1.0 };
+        for side in [first, -first] {
+            let d = side * (hy + ch.1 * f);
+            let centre = Point2::new(desk.centre.x + c * u - s * d, desk.centre.y + s * u + c * d);
+            let corners = rect_corners(centre, (ch.0 + 0.05, ch.1 + 0.05), yaw);
+            let radius = (ch.0 * ch.0 + ch.1 * ch.1).sqrt();
+            let others = &self.keep_out[..self.keep_out.len().saturating_sub(1)];
+            if corners.iter().all(|&p| self.on_floor(p))
+                && others
+                    .iter()
+                    .all(|(o, or)| centre.distance(*o) >= radius + or + 0.3)
+            {
+                self.put(ObjectClass::Chair, centre, yaw, ch, leg);
+                return;
+            }
+        }
+    }
+
+    /// One clutter item of a varied world: the study's three kinds, or a shelf or radiator
+    /// against a wall, or a square pillar (free, or as a pilaster on a wall).
+    pub(super) fn clutter_varied(&mut self) {
+        match self.rng.random_range(0..6u8) {
+            0..=2 => self.clutter_item(),
+            3 => {
+                let half = (
+                    self.rng.random_range(0.35..1.0f32),
+                    self.rng.random_range(0.12..0.22f32),
+                );
+                self.wall_clutter("shelf", half, 0.03);
+            }
+            4 => {
+                let half = (
+                    self.rng.random_range(0.25..0.75f32),
+                    self.rng.random_range(0.03..0.06f32),
+                );
+                self.wall_clutter("radiator", half, 0.06);
+            }
+            _ => {
+                let h = self.rng.random_range(0.07..0.17f32);
+                if self.rng.random_bool(0.5) {
+                    self.wall_clutter("square pillar", (h, h), 0.0);
+                } else {
+                    self.free_square_pillar(h);
+                }
+            }
+        }
+    }
+
+    /// A solid rectangle of clutter `kind` against a wall.
+    fn wall_clutter(&mut self, kind: &'static str, half: (f32, f32), gap_max: f32) {
+        if let Some(s) = self.wall_spot(half, false, gap_max, 0.2) {
+            let id = Surface::Clutter(self.clutter.len() as u16);
+            let refl = self.rng.random_range(0.2..0.95);
+            self.polygon(&rect_corners(s.centre, half, s.yaw), id, refl);
+            self.clutter.push(ClutterTruth {
+                kind,
+                centre: s.centre,
+            });
+            self.keep_out
+                .push((s.centre, (half.0 * half.0 + half.1 * half.1).sqrt()));
+        }
+    }
+
+    /// A free-standing square pillar of half-side `h`.
+    fn free_square_pillar(&mut self, h: f32) {
+        let r = h * core::f32::consts::SQRT_2;
+        for _ in 0..40 {
+            let c = self.random_floor_point();
+            if !self.fits(c, r, CLEARANCE) {
+                continue;
+            }
+            let yaw = self.rng.random_range(0.0..FRAC_PI_2);
+            let id = Surface::Clutter(self.clutter.len() as u16);
+            let refl = self.rng.random_range(0.3..0.95);
+            self.polygon(&rect_corners(c, (h, h), yaw), id, refl);
+            self.clutter.push(ClutterTruth {
+                kind: "square pillar",
+                centre: c,
+            });
+            self.keep_out.push((c, r));
+            return;
+        }
+    }
+
+    /// 0–2 partition stubs: walls 0.4–2 m long standing into the room from a wall, clear of
+    /// doorways.
+    pub(super) fn stubs(&mut self) {
+        for _ in 0..self.rng.random_range(0..=2u8) {
+            let len = self.rng.random_range(0.4..2.0f32);
+            let t = self.wall_t;
+            // A stub is a thin rectangle across the wall: long side `len` into the room.
+            let half = (t / 2.0, len / 2.0);
+            let Some(s) = self.wall_spot((len / 2.0, t / 2.0), true, 0.011, 0.5) else {
+                continue;
+            };
+            // `wall_spot` put it 1 cm off the face; a stub is built into the wall.
+            let (sn, cn) = s.yaw.sin_cos();
+            let centre = Point2::new(
+                s.centre.x - s.inward.x * 0.02,
+                s.centre.y - s.inward.y * 0.02,
+            );
+            let refl = self.wall_reflectivity();
+            self.polygon(
+                &rect_corners(centre, (half.1 + 0.02, half.0), s.yaw),
+                Surface::Wall,
+                refl,
+            );
+            // Keep furniture off it: discs along its length.
+            let n = (len / 0.4).ceil() as usize;
+            for i in 0..=n {
+                let k = i as f32 / n as f32 - 0.5;
+                let p = Point2::new(centre.x + cn * len * k, centre.y + sn * len * k);
+                self.keep_out.push((p, 0.2 + t));
+            }
+        }
+    }
+
+    /// An open door leaf in the gap from `a` to `b` (a wall along `dir`, outside `outward`):
+    /// hinged on one jamb, swung 60–110° into the room or out of it.
+    pub(super) fn door_leaf(&mut self, a: Point2, b: Point2, dir: Point2, outward: Point2) {
+        let width = a.distance(b) * 0.95;
+        let (hinge, toward) = if self.rng.random_bool(0.5) {
+            (a, dir)
+        } else {
+            (b, Point2::new(-dir.x, -dir.y))
+        };
+        let (hinge, side) = if self.rng.random_bool(0.5) {
+            (hinge, Point2::new(-outward.x, -outward.y))
+        } else {
+            (
+                Point2::new(
+                    hinge.x + outward.x * self.wall_t,
+                    hinge.y + outward.y * self.wall_t,
+                ),
+                outward,
+            )
+        };
+        let angle = self.rng.random_range(60.0f32..110.0).to_radians();
+        let (sa, ca) = angle.sin_cos();
+        let u = Point2::new(toward.x * ca + side.x * sa, toward.y * ca + side.y * sa);
+        let mid = Point2::new(hinge.x + u.x * width / 2.0, hinge.y + u.y * width / 2.0);
+        let refl = self.rng.random_range(0.3..0.9);
+        self.polygon(
+            &rect_corners(mid, (width / 2.0, 0.02), u.y.atan2(u.x)),
+            Surface::Wall,
+            refl,
+        );
+        self.keep_out.push((mid, width / 2.0));
+    }
+}
+
+#[cfg(test)]
+mod test {
+    use super::super::build::inside;
+    use super::super::{Shape, Surface, World, WorldConfig};
+    use super::*;
+
+    fn varied() -> WorldConfig {
+        WorldConfig {
+            varied: 1.0,
+            max_clutter: 6,
+            ..WorldConfig::default()
+        }
+    }
+
+    /// Whether segments `a–b` and `c–d` cross.
+    fn crosses(a: Point2, b: Point2, c: Point2, d: Point2) -> bool {
+        let side =
+            |p: Point2, q: Point2, r: Point2| (q.x - p.x) * (r.y - p.y) - (q.y - p.y) * (r.x - p.x);
+        side(a, b, c) * side(a, b, d) < 0.0 && side(c, d, a) * side(c, d, b) < 0.0
+    }
+
+    #[test]
+    fn drawn_only_when_asked_and_reproducible() {
+        for seed in 0..30 {
+            let a = World::generate(seed, &varied());
+            assert!(a.varied);
+            assert_eq!(a.prims, World::generate(seed, &varied()).prims);
+            assert!(!World::generate(seed, &WorldConfig::default()).varied);
+        }
+    }
+
+    #[test]
+    fn furniture_against_walls_and_at_desks_touches_nothing_else() {
+        let (mut pieces, mut against, mut tucked) = (0, 0, 0);
+        for seed in 0..80 {
+            let w = World::generate(seed, &varied());
+            assert!(w.on_floor(w.robot_start));
+            assert!(w.clearance(w.robot_start) >= 0.5, "seed {seed}");
+            for d in &w.doors {
+                assert!(d.width >= DOOR_WIDTH_MIN - 1e-4, "seed {seed}: {}", d.width);
+            }
+            for (i, o) in w.objects.iter().enumerate() {
+                pieces += 1;
+                let fp = o.footprint;
+                assert!(
+                    fp.iter().all(|&c| w.on_floor(c)),
+                    "seed {seed} piece {i} off the floor"
+                );
+                for p in &w.prims {
+                    if p.surface == Surface::Object(i as u16) {
+                        continue;
+                    }
+                    // A tucked chair's legs may stand under its desk (checked leg by leg below).
+                    if let Surface::Object(j) = p.surface {
+                        let other = w.objects[usize::from(j)].class;
+                        if [o.class, other].contains(&ObjectClass::Desk)
+                            && [o.class, other].contains(&ObjectClass::Chair)
+                        {
+                            continue;
+                        }
+                    }
+                    let hit = match p.shape {
+                        Shape::Circle { c, .. } => inside(&fp, c),
+                        Shape::Segment { a, b } => {
+                            inside(&fp, a)
+                                || inside(&fp, b)
+                                || (0..4).any(|k| crosses(a, b, fp[k], fp[(k + 1) % 4]))
+                        }
+                    };
+                    assert!(
+                        !hit,
+                        "seed {seed}: piece {i} overlaps {:?} {:?}",
+                        p.surface, p.shape
+                    );
+                }
+                // No two round things (legs, bins, pillars) of different owners intersect.
+                for (k, p) in w.prims.iter().enumerate() {
+                    for q in &w.prims[k + 1..] {
+                        if let (Shape::Circle { c: a, r: ra }, Shape::Circle { c: b, r: rb }) =
+                            (p.shape, q.shape)
+                        {
+                            assert!(
+                                p.surface == q.surface || a.distance(b) > ra + rb,
+                                "seed {seed}: {:?} and {:?} intersect",
+                                p.surface,
+                                q.surface
+                            );
+                        }
+                    }
+                }
+                let to_wall = w
+                    .prims
+                    .iter()
+                    .filter(|p| p.surface == Surface::Wall)
+                    .flat_map(|p| fp.iter().map(|&c| p.shape.distance(c)))
+                    .fold(f32::INFINITY, f32::min);
+                if to_wall < 0.12 {
+                    against += 1;
+                }
+                if o.class == ObjectClass::Chair
+                    && w.objects.iter().any(|d| {
+                        d.class == ObjectClass::Desk
+                            && (0..4).any(|k| {
+                                Shape::Segment {
+                                    a: d.footprint[k],
+                                    b: d.footprint[(k + 1) % 4],
+                                }
+                                .distance(o.centre)
+                                    < 0.35
+                            })
+                    })
+                {
+                    tucked += 1;
+                }
+            }
+        }
+        // 45 % of tries go to a wall when one has room; half the desks get a chair.
+        assert!(
+            against * 5 >= pieces,
+            "{against} of {pieces} against a wall"
+        );
+        assert!(tucked >= 20, "{tucked} chairs at desks in {pieces} pieces");
+    }
+}
