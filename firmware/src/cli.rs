@@ -129,6 +129,10 @@ pub struct Common {
     /// When the run ends, draw the map, robot, walls, doors and objects to this SVG file.
     #[arg(long, value_name = "PATH.svg")]
     pub snapshot: Option<PathBuf>,
+    /// A live map in this terminal instead of the per-frame lines: the scan, the robot, the
+    /// objects labelled with class and id, doors and people, redrawn in place.
+    #[arg(long)]
+    pub view: bool,
 }
 
 /// `umbra run`.

@@ -312,8 +312,19 @@ fn run_loop(
             (false, false) => Some(Box::new(std::io::stdout())),
         }
     };
-    let scene = human();
-    let stats = if common.verbose { human() } else { None };
+    if common.view && jsonl_to_stdout {
+        return Err((
+            EXIT_USAGE,
+            "--view draws on the terminal: send --jsonl to a file, not stdout".into(),
+        ));
+    }
+    // The live map takes the terminal's place of the per-frame lines.
+    let scene = if common.view { None } else { human() };
+    let stats = if common.verbose && !common.view {
+        human()
+    } else {
+        None
+    };
     let stop = Arc::new(AtomicBool::new(false));
     let flag = stop.clone();
     if let Err(e) = ctrlc::set_handler(move || flag.store(true, Ordering::Relaxed)) {
@@ -343,6 +354,9 @@ fn run_loop(
         sinks.push(Box::new(StatsSink(w)));
     }
     if let Some(v) = start_viz(common, source)? {
+        sinks.push(v);
+    }
+    if let Some(v) = start_view(common)? {
         sinks.push(v);
     }
     if let Some(p) = &common.snapshot {
@@ -414,6 +428,28 @@ fn start_viz(common: &Common, source: &LidarSource) -> Result<Option<Box<dyn Fra
         log::info!("recording to {}", p.display());
     }
     Ok(Some(Box::new(crate::viz::VizSink::new(link))))
+}
+
+/// `--view`: the live map in the terminal.
+#[cfg(feature = "view")]
+fn start_view(common: &Common) -> Result<Option<Box<dyn FrameSink>>, Failure> {
+    if !common.view {
+        return Ok(None);
+    }
+    let sink = crate::term_view::ViewSink::start().map_err(|m| (EXIT_USAGE, m))?;
+    Ok(Some(Box::new(sink)))
+}
+
+/// Built without the `view` feature: `--view` is an error.
+#[cfg(not(feature = "view"))]
+fn start_view(common: &Common) -> Result<Option<Box<dyn FrameSink>>, Failure> {
+    if common.view {
+        return Err((
+            EXIT_USAGE,
+            "--view: this umbra was built without the view feature".into(),
+        ));
+    }
+    Ok(None)
 }
 
 /// Built without the `viz` feature: `--record` and `--live` are errors.

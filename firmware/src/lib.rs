@@ -24,10 +24,12 @@
 //! | [`record_format`] | the replay channels of a recording, shared by writer and reader    |
 //! | `viz`           | `--record` MCAP and `--live` Foxglove WebSocket (feature `viz`)      |
 //! | `recording`     | replay of umbra's own MCAP recordings (feature `viz`)                |
+//! | `term_view`     | `--view`: a live map in the terminal, ratatui (feature `view`)       |
 //! | [`report`]      | `umbra report OUT.jsonl`: the deadline and power table of a run      |
 //!
 //! Features: `method-b` (tract and the compiled-in YOLO model), `viz` (MCAP and the live
-//! view), `sim` (the built-in simulated robot); all three on by default.
+//! Foxglove view), `sim` (the built-in simulated robot), `view` (the terminal map); all four on
+//! by default.
 #![deny(unsafe_code, missing_docs)]
 
 pub mod calibrate;
@@ -51,5 +53,7 @@ pub mod scene_line;
 pub mod sink;
 pub mod snapshot;
 pub mod source;
+#[cfg(feature = "view")]
+pub mod term_view;
 #[cfg(feature = "viz")]
 pub mod viz;

@@ -255,6 +255,14 @@ fn errors_name_what_is_wrong_and_exit_2_or_1() {
     assert_eq!(out.status.code(), Some(2));
     let out = umbra(&["run", "--lidar-model", "ld06", "--frames", "1"]);
     assert_eq!(out.status.code(), Some(2));
+
+    // The live map needs a terminal (here stdout is a pipe), and the terminal to itself.
+    let out = umbra(&["run", "--frames", "1", "--view"]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("--view"));
+    let out = umbra(&["run", "--frames", "1", "--view", "--jsonl", "-"]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("--jsonl"));
 }
 
 #[test]

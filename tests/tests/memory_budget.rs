@@ -174,6 +174,11 @@ fn buffers_in_code() -> Vec<(&'static str, usize, usize)> {
             size_of::<firmware::viz::VizFrame>(),
         ),
         (
+            "firmware::term_view::VIEW_POOL",
+            firmware::term_view::VIEW_POOL,
+            size_of::<firmware::term_view::ViewFrame>(),
+        ),
+        (
             "firmware::record_format::RECORD_RAW_BYTES",
             firmware::record_format::RECORD_RAW_BYTES,
             1,
