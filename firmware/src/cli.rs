@@ -13,9 +13,46 @@ pub const EXIT_FAULT: u8 = 1;
 /// A command's failure: the exit status and the message.
 pub type Failure = (u8, String);
 
+/// `umbra --version`: the version, then what this binary was built with — its features, the
+/// compiled-in models by SHA-256 (as `models/README.md` and `sha256sum models/yolo/*.onnx`
+/// name them), and the machine it was built for. (`-V` prints the version alone.)
+pub fn long_version() -> &'static str {
+    static TEXT: std::sync::OnceLock<String> = std::sync::OnceLock::new();
+    TEXT.get_or_init(|| {
+        let features: Vec<&str> = [
+            ("method-b", cfg!(feature = "method-b")),
+            ("viz", cfg!(feature = "viz")),
+            ("sim", cfg!(feature = "sim")),
+            ("view", cfg!(feature = "view")),
+        ]
+        .iter()
+        .filter_map(|(name, on)| on.then_some(*name))
+        .collect();
+        #[cfg(feature = "method-b")]
+        let model = format!(
+            "model: umbra-yolov8n.onnx sha256 {}\nmodel: umbra-yolov8n-int8.onnx sha256 {}",
+            models::yolo::BUILTIN_SHA256,
+            models::yolo::BUILTIN_INT8_SHA256
+        );
+        #[cfg(not(feature = "method-b"))]
+        let model = String::from("model: none (built without method-b: Method A only)");
+        format!(
+            "{}\nfeatures: {}\n{model}\nbuilt for: {}-{}",
+            env!("CARGO_PKG_VERSION"),
+            if features.is_empty() {
+                "none".to_string()
+            } else {
+                features.join(" ")
+            },
+            std::env::consts::ARCH,
+            std::env::consts::OS
+        )
+    })
+}
+
 /// umbra: camera-free perception for small indoor robots.
 #[derive(Debug, Parser)]
-#[command(name = "umbra", version, about)]
+#[command(name = "umbra", version, long_version = long_version(), about)]
 pub struct Cli {
     /// What to do.
     #[command(subcommand)]

@@ -727,3 +727,46 @@ fn bad_budgets_and_power_settings_name_the_field() {
     assert_eq!(out.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&out.stderr).contains("/nonexistent/run.jsonl"));
 }
+
+#[test]
+fn version_names_features_and_the_model_by_hash() {
+    let out = umbra(&["--version"]);
+    assert!(out.status.success());
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(text.starts_with("umbra "), "{text}");
+    assert!(text.contains("features: method-b viz sim view"), "{text}");
+    assert!(text.contains(models::yolo::BUILTIN_SHA256), "{text}");
+    assert!(text.contains("built for: "), "{text}");
+}
+
+/// The package's files say what the binary understands: the unit's command line parses, and
+/// the conffile it points at is a valid configuration.
+#[test]
+fn the_packaged_unit_and_configuration_are_valid() {
+    use clap::Parser;
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("debian");
+    let unit = std::fs::read_to_string(dir.join("umbra.service")).unwrap();
+    let exec = unit
+        .replace("\\\n", " ")
+        .lines()
+        .find_map(|l| l.strip_prefix("ExecStart=").map(str::to_owned))
+        .expect("an ExecStart line");
+    let args: Vec<&str> = exec.split_whitespace().collect();
+    assert_eq!(args[0], "/usr/bin/umbra");
+    let cli = firmware::cli::Cli::try_parse_from(&args);
+    assert!(cli.is_ok(), "{exec}: {:?}", cli.err());
+    assert!(exec.contains("--config /etc/umbra/umbra.toml"), "{exec}");
+    let out = umbra(&[
+        "run",
+        "--frames",
+        "1",
+        "--quiet",
+        "--config",
+        dir.join("umbra.toml").to_str().unwrap(),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+}

@@ -24,6 +24,10 @@ use tract_onnx::tract_hir::infer::Factoid;
 pub static BUILTIN_ONNX: &[u8] = include_bytes!("../yolo/umbra-yolov8n.onnx");
 /// The same model quantised (static int8, convolutions as `QLinearConv`).
 pub static BUILTIN_INT8_ONNX: &[u8] = include_bytes!("../yolo/umbra-yolov8n-int8.onnx");
+/// SHA-256 of [`BUILTIN_ONNX`] (hex), computed at build time.
+pub const BUILTIN_SHA256: &str = env!("UMBRA_MODEL_SHA256");
+/// SHA-256 of [`BUILTIN_INT8_ONNX`] (hex).
+pub const BUILTIN_INT8_SHA256: &str = env!("UMBRA_MODEL_INT8_SHA256");
 /// Name the compiled-in model goes by in messages.
 pub const BUILTIN_NAME: &str = "<built-in umbra-yolov8n.onnx>";
 
@@ -269,6 +273,20 @@ impl YoloModel {
 
 #[cfg(test)]
 mod test {
+    #[test]
+    fn the_version_names_the_compiled_in_models_by_their_hash() {
+        use sha2::{Digest, Sha256};
+        let hex = |b: &[u8]| -> String {
+            Sha256::digest(b)
+                .iter()
+                .map(|x| format!("{x:02x}"))
+                .collect()
+        };
+        assert_eq!(BUILTIN_SHA256, hex(BUILTIN_ONNX));
+        assert_eq!(BUILTIN_INT8_SHA256, hex(BUILTIN_INT8_ONNX));
+        assert_ne!(BUILTIN_SHA256, BUILTIN_INT8_SHA256);
+    }
+
     use super::*;
 
     #[test]
