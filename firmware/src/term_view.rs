@@ -116,7 +116,7 @@ impl ViewFrame {
         }
         self.people.clear();
         for p in l.people.unwrap_or(&[]).iter().take(VIEW_PEOPLE) {
-            let _ = self.people.push(p.clone());
+            let _ = self.people.push(*p);
         }
     }
 }
