@@ -184,8 +184,13 @@ enum Command {
 #[derive(Clone, Copy, ValueEnum)]
 enum FamilyArg {
     Sim,
+    /// The simulator's varied worlds (what Method B now trains on), held-out seeds.
+    Varied,
     Annex,
+    /// sim and annex.
     Both,
+    /// sim, varied and annex.
+    All,
 }
 
 #[derive(Clone, Copy, ValueEnum)]
@@ -482,8 +487,10 @@ fn run(cli: Cli) -> Result<(), String> {
             }
             let families = match family {
                 FamilyArg::Sim => vec![Family::Sim],
+                FamilyArg::Varied => vec![Family::Varied],
                 FamilyArg::Annex => vec![Family::Annex],
                 FamilyArg::Both => vec![Family::Sim, Family::Annex],
+                FamilyArg::All => vec![Family::Sim, Family::Varied, Family::Annex],
             };
             let world = match world {
                 WorldArg::On => vec![true],

@@ -22,6 +22,9 @@ use score::{CLASSES, Line, Tally, ratio, score_run};
 pub enum Family {
     /// umbra's simulator, held-out seeds.
     Sim,
+    /// umbra's simulator drawing only varied worlds (`WorldConfig::varied`), held-out seeds:
+    /// the kind of world Method B has been trained on since 2026-11-30, not the study's.
+    Varied,
     /// The annex: never trained or tuned on.
     Annex,
 }
@@ -31,6 +34,7 @@ impl Family {
     pub fn name(self) -> &'static str {
         match self {
             Family::Sim => "sim (held-out seeds)",
+            Family::Varied => "sim, varied worlds (held-out seeds)",
             Family::Annex => "annex (never tuned on)",
         }
     }
@@ -73,7 +77,8 @@ pub struct Outcome {
 /// Generates run `i` of `family`.
 pub fn generate(family: Family, seed: u64, i: usize, seconds: f64) -> GeneratedRun {
     match family {
-        Family::Sim => sim_family::generate(seed, i, seconds),
+        Family::Sim => sim_family::generate(seed, i, seconds, 0.0),
+        Family::Varied => sim_family::generate(seed, i, seconds, 1.0),
         Family::Annex => {
             let lidar = if i % 4 >= 2 {
                 drivers::lidar::LidarModel::Lds02
@@ -170,6 +175,7 @@ pub fn evaluate(cfg: &EvalConfig, mut progress: impl FnMut(&str)) -> Result<Vec<
             let run = generate(family, cfg.seed, i, cfg.seconds);
             let tag = match family {
                 Family::Sim => "sim",
+                Family::Varied => "varied",
                 Family::Annex => "annex",
             };
             let dir = cfg.dir.join(format!("{tag}-{i:03}"));

@@ -11,10 +11,14 @@ use crate::annex::GeneratedRun;
 use crate::run_truth::{Door, FrameTruth, Furniture, RunTruth, VISIBLE_RETURNS};
 
 /// Simulator run `i` of the evaluation seed `seed`: `seconds` long (even runs turn in place,
-/// odd runs tour, as the dataset's scenarios do), all three room kinds, clutter.
-pub fn generate(seed: u64, i: usize, seconds: f64) -> GeneratedRun {
+/// odd runs tour, as the dataset's scenarios do), all three room kinds, clutter; a share
+/// `varied` of the worlds drawn varied (`WorldConfig::varied`, then with up to 6 clutter
+/// items as the training data has them).
+pub fn generate(seed: u64, i: usize, seconds: f64, varied: f64) -> GeneratedRun {
     let world = WorldConfig {
         kinds: vec![RoomKind::Rect, RoomKind::LShape, RoomKind::TwoRooms],
+        varied,
+        max_clutter: if varied > 0.0 { 6 } else { 3 },
         ..WorldConfig::default()
     };
     let cfg = scenario_config(i, &world);
