@@ -367,6 +367,13 @@ impl Builder {
     }
 }
 
+/// `true` if `p` is strictly inside one of the floor rectangles `floor` (min, max).
+pub(super) fn on_floor(floor: &[(Point2, Point2)], p: Point2) -> bool {
+    floor
+        .iter()
+        .any(|(lo, hi)| p.x > lo.x && p.x < hi.x && p.y > lo.y && p.y < hi.y)
+}
+
 /// `true` if `p` is inside the convex quadrilateral `q` (counter-clockwise).
 pub(super) fn inside(q: &[Point2; 4], p: Point2) -> bool {
     (0..4).all(|i| {

@@ -474,9 +474,7 @@ impl World {
 
     /// `true` if `p` lies on the floor.
     pub fn on_floor(&self, p: Point2) -> bool {
-        self.floor
-            .iter()
-            .any(|(lo, hi)| p.x > lo.x && p.x < hi.x && p.y > lo.y && p.y < hi.y)
+        build::on_floor(&self.floor, p)
     }
 
     /// A random floor point with at least `clearance` to every surface.

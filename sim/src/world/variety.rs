@@ -42,9 +42,7 @@ struct WallSpot {
 impl Builder {
     /// `true` if `p` is strictly inside a floor rectangle.
     fn on_floor(&self, p: Point2) -> bool {
-        self.floor
-            .iter()
-            .any(|(lo, hi)| p.x > lo.x && p.x < hi.x && p.y > lo.y && p.y < hi.y)
+        super::build::on_floor(&self.floor, p)
     }
 
     /// Finds a place against a real wall (not the open side between two floor rectangles)
@@ -364,6 +362,21 @@ mod test {
             for d in &w.doors {
                 assert!(d.width >= DOOR_WIDTH_MIN - 1e-4, "seed {seed}: {}", d.width);
             }
+            // No two round things (legs, bins, pillars) of different owners intersect.
+            for (k, p) in w.prims.iter().enumerate() {
+                for q in &w.prims[k + 1..] {
+                    if let (Shape::Circle { c: a, r: ra }, Shape::Circle { c: b, r: rb }) =
+                        (p.shape, q.shape)
+                    {
+                        assert!(
+                            p.surface == q.surface || a.distance(b) > ra + rb,
+                            "seed {seed}: {:?} and {:?} intersect",
+                            p.surface,
+                            q.surface
+                        );
+                    }
+                }
+            }
             for (i, o) in w.objects.iter().enumerate() {
                 pieces += 1;
                 let fp = o.footprint;
@@ -397,21 +410,6 @@ mod test {
                         "seed {seed}: piece {i} overlaps {:?} {:?}",
                         p.surface, p.shape
                     );
-                }
-                // No two round things (legs, bins, pillars) of different owners intersect.
-                for (k, p) in w.prims.iter().enumerate() {
-                    for q in &w.prims[k + 1..] {
-                        if let (Shape::Circle { c: a, r: ra }, Shape::Circle { c: b, r: rb }) =
-                            (p.shape, q.shape)
-                        {
-                            assert!(
-                                p.surface == q.surface || a.distance(b) > ra + rb,
-                                "seed {seed}: {:?} and {:?} intersect",
-                                p.surface,
-                                q.surface
-                            );
-                        }
-                    }
                 }
                 let to_wall = w
                     .prims
