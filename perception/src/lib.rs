@@ -20,6 +20,8 @@
 //! | [`method_a`]   | the geometric pipeline end to end, classifier as a parameter |
 //! | [`yolo`]       | Method B's output: YOLOv8 decode, suppression, map-frame centres |
 //! | [`plausible`]  | furniture that cannot be: centres in or behind a wall seen this revolution |
+//! | [`wall_map`]   | the map's wall lines, gathered over revolutions; what lies in a wall's band |
+//! | [`wall_piece`] | a detection whose returns lie on a line that goes on as a wall does |
 //! | [`fusion`]     | one frame's objects from both methods: A's, and B's joined or added |
 //! | [`sight`]      | what a revolution showed of a footprint: hidden, in view, seen empty |
 //! | [`motion`]     | a track's alpha–beta motion filter; walking legs told from furniture |
@@ -46,5 +48,7 @@ pub mod raster;
 pub mod shape;
 pub mod sight;
 pub mod tracks;
+pub mod wall_map;
+pub mod wall_piece;
 pub mod walls;
 pub mod yolo;

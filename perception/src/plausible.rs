@@ -4,12 +4,16 @@
 //! a mixed pixel or a detection completed into space the LiDAR cannot see — not an object.
 //! Door frames live in wall lines and are exempt.
 //!
+//! The same holds for the walls the map has gathered over revolutions ([`drop_in_map_walls`],
+//! [`crate::wall_map`]): a wall broken in this revolution is still whole there.
+//!
 //! Only long segments vote ([`WALL_MIN_M`]): the face of a box is a short segment, and its own
 //! centre lies behind it.
 
 use crate::class::ObjectClass;
 use crate::fusion::FrameObjects;
 use crate::geometry::Point2;
+use crate::wall_map::WallMap;
 use crate::walls::Segment;
 
 /// Segments shorter than this are not trusted as walls, m (a box's longest face is ~0.8 m).
@@ -46,6 +50,14 @@ pub fn drop_walled(objects: &mut FrameObjects, sensor: Point2, walls: &[Segment]
     objects.retain(|o| {
         o.class == ObjectClass::DoorFrame || !in_or_behind_wall(sensor, o.centre, walls)
     });
+    (before - objects.len()) as u32
+}
+
+/// Drops the furniture of `objects` whose centre lies in the band of a wall `map` holds;
+/// returns how many.
+pub fn drop_in_map_walls(objects: &mut FrameObjects, map: &WallMap) -> u32 {
+    let before = objects.len();
+    objects.retain(|o| o.class == ObjectClass::DoorFrame || !map.holds(o.centre));
     (before - objects.len()) as u32
 }
 

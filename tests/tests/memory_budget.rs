@@ -139,6 +139,11 @@ fn buffers_in_code() -> Vec<(&'static str, usize, usize)> {
             size_of::<perception::tracks::Track>(),
         ),
         (
+            "perception::wall_map::MAX_MAP_WALLS",
+            perception::wall_map::MAX_MAP_WALLS,
+            size_of::<perception::wall_map::MapWall>(),
+        ),
+        (
             "perception::fusion::MAX_FRAME_OBJECTS",
             perception::fusion::MAX_FRAME_OBJECTS,
             size_of::<perception::fusion::FrameObject>(),

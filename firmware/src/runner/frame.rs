@@ -11,8 +11,10 @@ use perception::cloud::Scan;
 use perception::fusion::{Evidence, FrameObjects, merge_b, push_a};
 use perception::geometry::{Point2, Pose2};
 use perception::method_a::{MethodA, MethodAConfig};
-use perception::plausible::drop_walled;
+use perception::plausible::{drop_in_map_walls, drop_walled};
 use perception::tracks::Tracks;
+use perception::wall_map::WallMap;
+use perception::wall_piece::drop_wall_pieces;
 
 use super::FrameLoop;
 use super::history::ScanHistory;
@@ -70,8 +72,11 @@ pub(super) struct FrameState {
     people: Vec<PersonOut>,
     pub(super) walls: Vec<WallOut>,
     pub(super) doors: Vec<DoorOut>,
-    /// Detections dropped for lying in or behind a wall (`perception::plausible`).
+    /// Detections dropped for lying in or behind a wall (`perception::plausible`), or in
+    /// the band of a wall the map holds (`perception::wall_map`).
     pub(super) walled: u64,
+    /// The map's wall lines, gathered from Method A's segments over the revolutions.
+    wall_map: Box<WallMap>,
     /// While recording: the LiDAR bytes read since the recorder last took them.
     recording: Option<RecordingInput>,
 }
@@ -110,6 +115,7 @@ impl FrameState {
                 perception::doors::MAX_DOORS + perception::tracks::MAX_TRACKS,
             ),
             walled: 0,
+            wall_map: Box::default(),
             recording: recording.then(|| RecordingInput {
                 raw: Box::new(heapless::Vec::new()),
                 dropped: 0,
@@ -304,22 +310,24 @@ impl<S: RevolutionStream> FrameLoop<'_, S> {
             (None, Some(b)) => b.mount,
             (None, None) => Pose2::IDENTITY,
         };
-        // Furniture in or behind a wall this revolution showed is not furniture.
+        // Furniture in or behind a wall this revolution showed, or in the band of a wall the
+        // map holds (one this revolution may show broken), is not furniture.
         if let Some((_, m)) = &opts.method_a {
             let sensor = pose.end.compose(m);
-            st.walled += u64::from(drop_walled(
-                &mut st.fused,
-                Point2::new(sensor.x, sensor.y),
-                st.method_a.segments(),
-            ));
+            let sensor = Point2::new(sensor.x, sensor.y);
+            st.wall_map.update(frame, st.method_a.segments(), sensor);
+            st.walled += u64::from(drop_walled(&mut st.fused, sensor, st.method_a.segments()));
+            st.walled += u64::from(drop_in_map_walls(&mut st.fused, &st.wall_map));
         }
+        // Nor is a detection whose returns lie on a line that goes on as a wall does.
+        let lidar = midway(&pose.start, &pose.end).compose(&mount);
+        st.walled += u64::from(drop_wall_pieces(&mut st.fused, &lidar, st.history.newest()));
         st.detections.clear();
         for (id, o) in st.fused.iter().enumerate() {
             st.detections.push(ObjectOut::new(id, o));
         }
         st.objects.clear();
         if let Some(cfg) = opts.world.as_ref() {
-            let lidar = midway(&pose.start, &pose.end).compose(&mount);
             let mid_s = t + period * 0.5;
             st.tracks
                 .update(frame, mid_s, &st.fused, &lidar, st.history.newest(), cfg);
@@ -331,6 +339,11 @@ impl<S: RevolutionStream> FrameLoop<'_, S> {
             // method found them.
             st.doors.clear();
             for t in st.tracks.confirmed() {
+                // A track that the map's walls now hold is a piece of wall: no hit will come
+                // (its detections are dropped above) and it fades; it is not reported meanwhile.
+                if t.class() != ObjectClass::DoorFrame && st.wall_map.holds(t.centre) {
+                    continue;
+                }
                 let o = ObjectOut::track(t);
                 if t.class() == ObjectClass::DoorFrame && t.width_m > 0.0 {
                     push_door(

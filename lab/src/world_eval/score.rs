@@ -107,7 +107,7 @@ impl Line {
 }
 
 /// Counts, summed over runs; the rates are derived when reporting.
-#[derive(Debug, Clone, Default, PartialEq, serde::Serialize)]
+#[derive(Debug, Clone, Default, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Tally {
     /// Runs.
     pub runs: u32,
@@ -443,6 +443,7 @@ impl Tally {
         );
         sum!(
             id_switches,
+            phantoms_at_wall,
             move_stuck,
             move_unseen,
             people_as_furniture,
@@ -624,6 +625,62 @@ mod test {
         assert_eq!(s.map_tp, [0, 0, 0]);
         assert_eq!(s.map_visible, [1, 0, 0]);
         assert_eq!(s.map_reported, [0, 2, 1]);
+    }
+
+    #[test]
+    fn summing_tallies_sums_every_count() {
+        // Every numeric field of the JSON form of `a + a` is twice that of `a`: a field left
+        // out of `add` (as `phantoms_at_wall` once was) shows here.
+        fn numbers(v: &serde_json::Value, out: &mut Vec<f64>) {
+            match v {
+                serde_json::Value::Number(n) => out.push(n.as_f64().unwrap_or(f64::NAN)),
+                serde_json::Value::Array(a) => a.iter().for_each(|x| numbers(x, out)),
+                serde_json::Value::Object(o) => o.values().for_each(|x| numbers(x, out)),
+                _ => {}
+            }
+        }
+        let one = |k: u32| {
+            let mut t = Tally::default();
+            let mut j = serde_json::to_value(&t).unwrap();
+            if let serde_json::Value::Object(o) = &mut j {
+                for (i, v) in o.values_mut().enumerate() {
+                    let x = k + i as u32;
+                    match v {
+                        serde_json::Value::Number(_) => *v = x.into(),
+                        serde_json::Value::Array(a) if a.is_empty() => {
+                            *v = vec![f64::from(x)].into()
+                        }
+                        serde_json::Value::Array(a) => a.iter_mut().for_each(|e| *e = x.into()),
+                        _ => {}
+                    }
+                }
+            }
+            t = serde_json::from_value(j).unwrap();
+            t
+        };
+        let a = one(1);
+        let mut sum = Tally::default();
+        sum.add(&a);
+        sum.add(&a);
+        let (ja, js) = (
+            serde_json::to_value(&a).unwrap(),
+            serde_json::to_value(&sum).unwrap(),
+        );
+        let (serde_json::Value::Object(oa), serde_json::Value::Object(os)) = (&ja, &js) else {
+            panic!("a tally is a JSON object");
+        };
+        for (key, va) in oa {
+            let (mut xa, mut xs) = (Vec::new(), Vec::new());
+            numbers(va, &mut xa);
+            numbers(&os[key], &mut xs);
+            if key == "move_gone_s" {
+                // A list of times: concatenated, not doubled.
+                assert_eq!(xs.len(), 2 * xa.len());
+                continue;
+            }
+            let doubled: Vec<f64> = xa.iter().map(|x| 2.0 * x).collect();
+            assert_eq!(xs, doubled, "{key} is left out of Tally::add");
+        }
     }
 
     #[test]
