@@ -1,10 +1,11 @@
 //! Whether a detection is a piece of a wall, judged from one revolution's own points rather
 //! than from the wall segments Method A fitted (which a wall seen at a grazing angle, or broken
 //! by what stands in front of it, may lack). A detection is a wall piece when most returns
-//! around its centre lie on one thin line (at a corner: the longer arm), that line passes through the centre or in front of
-//! it (the centre in the wall, or completed behind it), and the same line goes on well beyond
-//! any piece of furniture's size ([`CONTINUES_FROM_M`]): a box's face ends with the box, a
-//! wall does not. `no_std`, allocation-free: two passes over the revolution.
+//! around its centre lie on one line (within the range noise; at a corner: either arm), that
+//! line passes through the centre or in front of it (the centre in the wall, or completed
+//! behind it), and the same line goes on, unbroken, well beyond any piece of furniture's size
+//! ([`CONTINUES_FROM_M`]): a box's face ends with the box, a wall does not. `no_std`,
+//! allocation-free: a few passes over the revolution.
 
 use crate::class::ObjectClass;
 use crate::fusion::FrameObjects;
@@ -18,8 +19,11 @@ pub const NEAR_M: f32 = 0.3;
 pub const MAX_NEAR: usize = 64;
 /// At least this many of them, half of them on one line.
 pub const MIN_POINTS: u32 = 3;
-/// Largest spread across their line (RMS), m: a wall's face within the LiDAR's noise.
+/// A return is on a line within this, m, or twice the range noise where that is more.
 pub const THIN_M: f32 = 0.02;
+/// Range noise (σ) as a share of range: the LDS-01's spec of ±5 % taken as 2σ, the worst of
+/// the LiDARs umbra reads (the simulator draws the same).
+pub const NOISE_FRAC: f32 = 0.025;
 /// The centre may lie this far in front of the line (towards the LiDAR), m: furniture
 /// against a wall has its centre at least half its depth (≥ 0.15 m) in front of the face.
 pub const IN_FRONT_M: f32 = 0.1;
@@ -30,8 +34,19 @@ pub const BEHIND_M: f32 = 0.3;
 pub const CONTINUES_FROM_M: f32 = 0.55;
 /// ... up to this far, m.
 pub const CONTINUES_TO_M: f32 = 1.5;
-/// A return on the line beyond: within this of it, m.
+/// A return on the line beyond: within this of it, m, or twice the range noise.
 pub const ON_LINE_M: f32 = 0.03;
+/// Candidate lines tried per detection, at most (each one more pass over the revolution).
+pub const MAX_TRIES: usize = 6;
+/// Cells along the line in which the continuation is looked for (`CELLS × CELL_M` =
+/// 2 × [`CONTINUES_TO_M`]).
+const CELLS: u32 = 60;
+/// See `CELLS`, m.
+const CELL_M: f32 = 2.0 * CONTINUES_TO_M / CELLS as f32;
+/// Cells from the centre within which the line's own returns must begin (0.3 m).
+const NEAR_CELLS: u32 = 6;
+/// A wall's returns may leave a gap this long, m, or 2.5 times their spacing where more.
+pub const MAX_GAP_M: f32 = 0.15;
 /// Returns on the line beyond, at least.
 pub const CONTINUE_POINTS: u32 = 4;
 
@@ -43,6 +58,8 @@ pub fn is_wall_piece(centre: Point2, lidar: &Pose2, ranges: &[f32; BINS]) -> boo
     }
     // In the LiDAR's frame: the sensor at the origin.
     let c = lidar.inverse().transform(centre);
+    let two_sigma = 2.0 * NOISE_FRAC * c.norm();
+    let (thin, on_line) = (THIN_M.max(two_sigma), ON_LINE_M.max(two_sigma));
     let points = || {
         ranges
             .iter()
@@ -61,10 +78,11 @@ pub fn is_wall_piece(centre: Point2, lidar: &Pose2, ranges: &[f32; BINS]) -> boo
     if n < MIN_POINTS as usize {
         return false;
     }
-    // The line with the most of them within THIN_M (a wall's corner: its longer arm), tried
-    // through pairs a third of the run apart; then its inliers' principal axis.
+    // Lines through pairs a third of the run apart that hold at least half of them within
+    // `thin` (at a wall's corner: either arm); each is refined to its inliers' principal axis
+    // and tried, the first [`MAX_TRIES`] at most.
     let step = (n / 3).max(1);
-    let mut best: Option<(usize, Point2, Point2)> = None;
+    let mut tries = 0;
     for i in 0..n {
         let (a, b) = (near[i], near[(i + step) % n]);
         if a.distance(b) < 0.05 {
@@ -74,24 +92,40 @@ pub fn is_wall_piece(centre: Point2, lidar: &Pose2, ranges: &[f32; BINS]) -> boo
         let nrm = Point2::new(-e.y / e.norm(), e.x / e.norm());
         let count = near
             .iter()
-            .filter(|p| libm::fabsf(dot(**p - a, nrm)) <= THIN_M)
+            .filter(|p| libm::fabsf(dot(**p - a, nrm)) <= thin)
             .count();
-        if best.is_none_or(|(k, ..)| count > k) {
-            best = Some((count, a, nrm));
+        if count < MIN_POINTS as usize || 2 * count < n {
+            continue;
+        }
+        if continues_as_wall(c, &near, a, nrm, thin, on_line, &points) {
+            return true;
+        }
+        tries += 1;
+        if tries == MAX_TRIES {
+            break;
         }
     }
-    let Some((count, a, nrm)) = best else {
-        return false;
-    };
-    if count < MIN_POINTS as usize || 2 * count < n {
-        return false;
-    }
+    false
+}
+
+/// Whether the line through `a` with normal `nrm` (refined to the principal axis of the
+/// returns `near` within `thin` of it) has the centre `c` on it or behind it and goes on with
+/// returns of `points` beyond any furniture's size.
+fn continues_as_wall<I: Iterator<Item = Point2>>(
+    c: Point2,
+    near: &[Point2],
+    a: Point2,
+    nrm: Point2,
+    thin: f32,
+    on_line: f32,
+    points: &impl Fn() -> I,
+) -> bool {
     let inliers = || {
         near.iter()
             .copied()
-            .filter(move |p| libm::fabsf(dot(*p - a, nrm)) <= THIN_M)
+            .filter(move |p| libm::fabsf(dot(*p - a, nrm)) <= thin)
     };
-    let k = count as f32;
+    let k = inliers().count() as f32;
     let m = inliers().fold(Point2::new(0.0, 0.0), |s, p| s + p);
     let m = Point2::new(m.x / k, m.y / k);
     let (mut cxx, mut cxy, mut cyy) = (0.0f32, 0.0f32, 0.0f32);
@@ -112,15 +146,63 @@ pub fn is_wall_piece(centre: Point2, lidar: &Pose2, ranges: &[f32; BINS]) -> boo
     if !(-BEHIND_M..=IN_FRONT_M).contains(&s) {
         return false;
     }
-    // Pass 2: does the line go on beyond any furniture's size?
-    let beyond = points()
-        .filter(|p| {
-            let d = p.distance(c);
-            (CONTINUES_FROM_M..=CONTINUES_TO_M).contains(&d)
-                && libm::fabsf(dot(*p - m, nrm)) <= ON_LINE_M
-        })
-        .count() as u32;
-    beyond >= CONTINUE_POINTS
+    // Pass 2: does the line go on beyond any furniture's size, unbroken from the returns
+    // near the centre (a tilted fit through a box's face may cross a wall further on, across
+    // empty floor)? Returns on it, in cells of CELL_M along it.
+    let u0 = dot(c - m, dir);
+    let (mut cells, mut beyond) = (0u64, 0u32);
+    for p in points() {
+        if libm::fabsf(dot(p - m, nrm)) > on_line {
+            continue;
+        }
+        let u = dot(p - m, dir) - u0;
+        if libm::fabsf(u) >= CONTINUES_TO_M {
+            continue;
+        }
+        cells |= 1 << (((u + CONTINUES_TO_M) / CELL_M) as u32).min(CELLS - 1);
+        if p.distance(c) >= CONTINUES_FROM_M {
+            beyond += 1;
+        }
+    }
+    if beyond < CONTINUE_POINTS {
+        return false;
+    }
+    // The gap a wall may show: its returns' spacing at this range and incidence, a few times.
+    let range = c.norm().max(0.1);
+    let cos_inc = (libm::fabsf(dot(c, nrm)) / range).max(0.2);
+    let spacing = range * core::f32::consts::PI / 180.0 / cos_inc;
+    let gap = (libm::ceilf(MAX_GAP_M.max(2.5 * spacing) / CELL_M) as u32).max(1);
+    let mid = CELLS / 2;
+    let filled = |k: u32| cells & (1 << k) != 0;
+    let from_cells = libm::ceilf(CONTINUES_FROM_M / CELL_M) as u32;
+    // Outward from the filled cell nearest the centre, each way, while the gaps stay short.
+    let start = (0..=NEAR_CELLS).find_map(|d| {
+        [mid.saturating_sub(d), (mid + d).min(CELLS - 1)]
+            .into_iter()
+            .find(|&k| filled(k))
+    });
+    let Some(start) = start else {
+        return false;
+    };
+    let mut last = start;
+    for k in start + 1..CELLS {
+        if filled(k) {
+            if k - last - 1 > gap {
+                break;
+            }
+            last = k;
+        }
+    }
+    let mut first = start;
+    for k in (0..start).rev() {
+        if filled(k) {
+            if first - k - 1 > gap {
+                break;
+            }
+            first = k;
+        }
+    }
+    last.saturating_sub(mid) >= from_cells || mid.saturating_sub(first) >= from_cells
 }
 
 fn dot(a: Point2, b: Point2) -> f32 {
@@ -203,6 +285,36 @@ mod test {
         let robot = Pose2::new(1.0, 2.0, 0.7);
         let wall_in_map = robot.transform(Point2::new(2.5, 0.4));
         assert!(is_wall_piece(wall_in_map, &robot, &r));
+    }
+
+    /// `r` with the simulator's worst range noise (σ = 2.5 % of range), drawn reproducibly.
+    fn noisy(mut r: [f32; BINS], seed: u32) -> [f32; BINS] {
+        let mut x = seed;
+        let mut uniform = || {
+            x = x.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);
+            (x >> 8) as f32 / (1u32 << 24) as f32
+        };
+        for v in r.iter_mut().filter(|v| **v > 0.0) {
+            // Irwin–Hall: the sum of 12 uniforms less 6 is close to a standard normal.
+            let z: f32 = (0..12).map(|_| uniform()).sum::<f32>() - 6.0;
+            *v *= 1.0 + NOISE_FRAC * z;
+        }
+        r
+    }
+
+    #[test]
+    fn within_the_range_noise_too() {
+        let at = Pose2::IDENTITY;
+        for seed in 1..6 {
+            let r = noisy(scan(2.5, &[]), seed);
+            assert!(is_wall_piece(Point2::new(2.5, 0.4), &at, &r), "seed {seed}");
+            let c = Point2::new(1.6, -0.5);
+            let r = noisy(box_scan(3.0, c, 0.4, 0.6), seed);
+            assert!(!is_wall_piece(c, &at, &r), "seed {seed}");
+            let c = Point2::new(2.8, 0.3);
+            let r = noisy(box_scan(3.0, c, 0.4, 0.6), seed);
+            assert!(!is_wall_piece(c, &at, &r), "seed {seed}");
+        }
     }
 
     #[test]
