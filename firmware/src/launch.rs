@@ -525,7 +525,7 @@ fn print_summary(s: &Summary) {
     );
     if s.walled_detections > 0 {
         eprintln!(
-            "umbra: {} detections in or behind a wall dropped (not furniture)",
+            "umbra: {} detections that cannot be furniture dropped (in or behind a wall, a piece of a wall, a round \"box\")",
             s.walled_detections
         );
     }

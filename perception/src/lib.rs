@@ -22,6 +22,7 @@
 //! | [`plausible`]  | furniture that cannot be: centres in or behind a wall seen this revolution |
 //! | [`wall_map`]   | the map's wall lines, gathered over revolutions; what lies in a wall's band |
 //! | [`wall_piece`] | a detection whose returns lie on a line that goes on as a wall does |
+//! | [`outline`]    | a "box" whose returns lie on an arc (a bin, a round pillar) |
 //! | [`fusion`]     | one frame's objects from both methods: A's, and B's joined or added |
 //! | [`sight`]      | what a revolution showed of a footprint: hidden, in view, seen empty |
 //! | [`motion`]     | a track's alpha–beta motion filter; walking legs told from furniture |
@@ -42,6 +43,7 @@ pub mod geometry;
 pub mod merge;
 pub mod method_a;
 pub mod motion;
+pub mod outline;
 pub mod plausible;
 pub mod pose;
 pub mod raster;

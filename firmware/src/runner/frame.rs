@@ -11,6 +11,7 @@ use perception::cloud::Scan;
 use perception::fusion::{Evidence, FrameObjects, merge_b, push_a};
 use perception::geometry::{Point2, Pose2};
 use perception::method_a::{MethodA, MethodAConfig};
+use perception::outline::drop_round_boxes;
 use perception::plausible::{drop_in_map_walls, drop_walled};
 use perception::tracks::Tracks;
 use perception::wall_map::WallMap;
@@ -72,8 +73,9 @@ pub(super) struct FrameState {
     people: Vec<PersonOut>,
     pub(super) walls: Vec<WallOut>,
     pub(super) doors: Vec<DoorOut>,
-    /// Detections dropped for lying in or behind a wall (`perception::plausible`), or in
-    /// the band of a wall the map holds (`perception::wall_map`).
+    /// Detections dropped for lying in or behind a wall (`perception::plausible`), in the
+    /// band of a wall the map holds (`perception::wall_map`), on a piece of wall
+    /// (`perception::wall_piece`), or as a "box" on an arc (`perception::outline`).
     pub(super) walled: u64,
     /// The map's wall lines, gathered from Method A's segments over the revolutions.
     wall_map: Box<WallMap>,
@@ -322,6 +324,8 @@ impl<S: RevolutionStream> FrameLoop<'_, S> {
         // Nor is a detection whose returns lie on a line that goes on as a wall does.
         let lidar = midway(&pose.start, &pose.end).compose(&mount);
         st.walled += u64::from(drop_wall_pieces(&mut st.fused, &lidar, st.history.newest()));
+        // A "box" whose returns lie on an arc is a bin or a round pillar.
+        st.walled += u64::from(drop_round_boxes(&mut st.fused, &lidar, st.history.newest()));
         st.detections.clear();
         for (id, o) in st.fused.iter().enumerate() {
             st.detections.push(ObjectOut::new(id, o));

@@ -1,0 +1,291 @@
+//! What a detection's own returns say against its class: a box has flat faces, so a box whose
+//! returns lie on an arc — a bin, a round pillar, a person's leg — is not a box. The longest
+//! unbroken run of the revolution's returns near the centre is fitted three ways: a line, two
+//! lines meeting at the point farthest from its chord (a box seen across a corner), and a
+//! circle (Kåsa's algebraic fit). It is round when the circle fits markedly better than one
+//! line and better than two,
+//! with a radius of a bin or a pillar, bulging towards the LiDAR (where the range noise swamps
+//! the curve, the three fits read alike and the returns say nothing). `no_std`,
+//! allocation-free.
+
+use heapless::Vec;
+
+use crate::class::ObjectClass;
+use crate::fusion::FrameObjects;
+use crate::geometry::{Point2, Pose2};
+use crate::sight::BINS;
+
+/// Returns this close to the centre are the detection's, m.
+pub const NEAR_M: f32 = 0.35;
+/// Returns in the run at least.
+pub const MIN_POINTS: usize = 6;
+/// Returns looked at, at most.
+pub const MAX_NEAR: usize = 64;
+/// Radii of round things that are not boxes, m (a bin of 0.12 m to a pillar of 0.35 m).
+pub const MIN_RADIUS_M: f32 = 0.06;
+/// See [`MIN_RADIUS_M`].
+pub const MAX_RADIUS_M: f32 = 0.35;
+/// The circle's RMS must be at most this share of one line's ...
+pub const ROUND_RATIO: f32 = 0.6;
+/// ... and at most two lines' (which have one parameter more) times this: a box seen across
+/// a corner fits two lines to the noise and a circle worse.
+pub const CORNER_RATIO: f32 = 1.0;
+/// The run must leave a straight line by this much (RMS), m. Where the range noise swamps a
+/// curve, the three fits read alike and [`ROUND_RATIO`] says no.
+pub const MIN_CURVE_M: f32 = 0.01;
+
+/// Whether the returns of `ranges` (seen from `lidar`, map frame) near `centre` lie on an arc.
+pub fn is_round(centre: Point2, lidar: &Pose2, ranges: &[f32; BINS]) -> bool {
+    if !(centre.x.is_finite() && centre.y.is_finite()) {
+        return false;
+    }
+    let c = lidar.inverse().transform(centre);
+    let range = c.norm();
+    if range < 0.05 {
+        return false;
+    }
+    // Bins from the one opposite the centre's bearing, so the object's bins are in one piece.
+    let bearing = libm::atan2f(c.y, c.x).to_degrees();
+    let start = (libm::roundf(bearing) as i32 + 180).rem_euclid(BINS as i32) as usize;
+    let spacing = range * core::f32::consts::PI / 180.0;
+    let link = (3.0 * spacing).max(0.06);
+    // The longest unbroken run of returns near the centre.
+    let mut best: Vec<Point2, MAX_NEAR> = Vec::new();
+    let mut run: Vec<Point2, MAX_NEAR> = Vec::new();
+    for k in 0..BINS {
+        let d = (start + k) % BINS;
+        let r = ranges[d];
+        let p = (r > 0.0 && r.is_finite()).then(|| Point2::from_polar(r, (d as f32).to_radians()));
+        match p.filter(|p| p.distance(c) <= NEAR_M) {
+            Some(p) if run.last().is_none_or(|q| q.distance(p) <= link) => {
+                let _ = run.push(p);
+            }
+            Some(p) => {
+                if run.len() > best.len() {
+                    best = run.clone();
+                }
+                run.clear();
+                let _ = run.push(p);
+            }
+            None if r > 0.0 && r.is_finite() => {
+                if run.len() > best.len() {
+                    best = run.clone();
+                }
+                run.clear();
+            }
+            None => {} // no return: a dropout does not break a run
+        }
+    }
+    if run.len() > best.len() {
+        best = run;
+    }
+    if best.len() < MIN_POINTS {
+        return false;
+    }
+    let pts = &best[..];
+    let line = line_sse(pts);
+    let n = pts.len() as f32;
+    let rms_line = libm::sqrtf(line / n);
+    if rms_line < MIN_CURVE_M {
+        return false; // straight: nothing to say
+    }
+    // Two lines split at the point farthest from the chord.
+    let (a, b) = (pts[0], pts[pts.len() - 1]);
+    let e = b - a;
+    let far = (0..pts.len())
+        .max_by(|&i, &j| {
+            let di = libm::fabsf((pts[i] - a).x * e.y - (pts[i] - a).y * e.x);
+            let dj = libm::fabsf((pts[j] - a).x * e.y - (pts[j] - a).y * e.x);
+            di.total_cmp(&dj)
+        })
+        .unwrap_or(0);
+    let two = if far >= 1 && far + 2 <= pts.len() {
+        line_sse(&pts[..=far]) + line_sse(&pts[far..])
+    } else {
+        line
+    };
+    let rms_two = libm::sqrtf(two / n);
+    let Some((cc, r, sse)) = circle(pts) else {
+        return false;
+    };
+    let rms_circle = libm::sqrtf(sse / n);
+    let mean = pts.iter().fold(Point2::new(0.0, 0.0), |s, p| s + *p);
+    let mean = Point2::new(mean.x / n, mean.y / n);
+    #[cfg(test)]
+    std::eprintln!(
+        "n {n} line {rms_line} two {rms_two} circle {rms_circle} r {r} cc {cc:?} mean {mean:?}"
+    );
+    (MIN_RADIUS_M..=MAX_RADIUS_M).contains(&r)
+        && cc.norm() > mean.norm()
+        && rms_circle <= ROUND_RATIO * rms_line
+        && rms_circle <= CORNER_RATIO * rms_two
+}
+
+/// Sum of squared distances of `pts` from their principal axis.
+fn line_sse(pts: &[Point2]) -> f32 {
+    let n = pts.len() as f32;
+    if n < 2.0 {
+        return 0.0;
+    }
+    let m = pts.iter().fold(Point2::new(0.0, 0.0), |s, p| s + *p);
+    let m = Point2::new(m.x / n, m.y / n);
+    let (mut cxx, mut cxy, mut cyy) = (0.0f32, 0.0f32, 0.0f32);
+    for p in pts {
+        let d = *p - m;
+        cxx += d.x * d.x;
+        cxy += d.x * d.y;
+        cyy += d.y * d.y;
+    }
+    let half_tr = 0.5 * (cxx + cyy);
+    let det = cxx * cyy - cxy * cxy;
+    (half_tr - libm::sqrtf((half_tr * half_tr - det).max(0.0))).max(0.0)
+}
+
+/// Kåsa's circle through `pts`: centre, radius and the sum of squared radial residuals.
+fn circle(pts: &[Point2]) -> Option<(Point2, f32, f32)> {
+    // Centred on the mean for conditioning; minimise Σ (x² + y² + D x + E y + F)².
+    let n = pts.len() as f32;
+    let m = pts.iter().fold(Point2::new(0.0, 0.0), |s, p| s + *p);
+    let m = Point2::new(m.x / n, m.y / n);
+    let (mut sxx, mut sxy, mut syy, mut sxz, mut syz, mut sz) = (0.0f32, 0.0, 0.0, 0.0, 0.0, 0.0);
+    for p in pts {
+        let (x, y) = (p.x - m.x, p.y - m.y);
+        let z = x * x + y * y;
+        sxx += x * x;
+        sxy += x * y;
+        syy += y * y;
+        sxz += x * z;
+        syz += y * z;
+        sz += z;
+    }
+    // With centred data Σx = Σy = 0: F = −Σz / n, and [sxx sxy; sxy syy] [D E]ᵀ = −[sxz syz]ᵀ.
+    let det = sxx * syy - sxy * sxy;
+    if libm::fabsf(det) < 1e-12 {
+        return None;
+    }
+    let d = (-sxz * syy + syz * sxy) / det;
+    let e = (-syz * sxx + sxz * sxy) / det;
+    let f = -sz / n;
+    let centre = Point2::new(m.x - d / 2.0, m.y - e / 2.0);
+    let r2 = d * d / 4.0 + e * e / 4.0 - f;
+    if !(r2 > 0.0 && r2.is_finite()) {
+        return None;
+    }
+    let r = libm::sqrtf(r2);
+    let sse = pts
+        .iter()
+        .map(|p| {
+            let q = p.distance(centre) - r;
+            q * q
+        })
+        .sum();
+    Some((centre, r, sse))
+}
+
+/// Drops the boxes of `objects` whose returns lie on an arc ([`is_round`]); returns how many.
+pub fn drop_round_boxes(objects: &mut FrameObjects, lidar: &Pose2, ranges: &[f32; BINS]) -> u32 {
+    let before = objects.len();
+    objects.retain(|o| o.class != ObjectClass::Box || !is_round(o.centre, lidar, ranges));
+    (before - objects.len()) as u32
+}
+
+#[cfg(test)]
+mod test {
+    use super::*;
+
+    /// A revolution from the origin with a wall along x = 4 and a circle or a box in front.
+    fn scan(round: Option<(Point2, f32)>, square: Option<(Point2, f32, f32, f32)>) -> [f32; BINS] {
+        let mut r = [0.0f32; BINS];
+        for (d, slot) in r.iter_mut().enumerate() {
+            let a = (d as f32).to_radians();
+            let (dx, dy) = (libm::cosf(a), libm::sinf(a));
+            let mut best = if dx > 0.3 { 4.0 / dx } else { 0.0 };
+            let mut take = |t: f32| {
+                if t > 0.0 && (best == 0.0 || t < best) {
+                    best = t;
+                }
+            };
+            if let Some((c, rad)) = round {
+                // |t·u − c|² = rad²
+                let b = dx * c.x + dy * c.y;
+                let disc = b * b - (c.x * c.x + c.y * c.y - rad * rad);
+                if disc >= 0.0 {
+                    take(b - libm::sqrtf(disc));
+                }
+            }
+            if let Some((c, w, h, yaw)) = square {
+                // The four edges of a box turned by `yaw`.
+                let (s, co) = (libm::sinf(yaw), libm::cosf(yaw));
+                let corner =
+                    |u: f32, v: f32| Point2::new(c.x + co * u - s * v, c.y + s * u + co * v);
+                let k = [
+                    corner(-w / 2.0, -h / 2.0),
+                    corner(w / 2.0, -h / 2.0),
+                    corner(w / 2.0, h / 2.0),
+                    corner(-w / 2.0, h / 2.0),
+                ];
+                for i in 0..4 {
+                    let (p, q) = (k[i], k[(i + 1) % 4]);
+                    let e = q - p;
+                    let den = dx * e.y - dy * e.x;
+                    if libm::fabsf(den) < 1e-9 {
+                        continue;
+                    }
+                    let t = (p.x * e.y - p.y * e.x) / den;
+                    let u = (p.x * dy - p.y * dx) / den;
+                    if (0.0..=1.0).contains(&u) {
+                        take(t);
+                    }
+                }
+            }
+            *slot = best;
+        }
+        r
+    }
+
+    fn noisy(mut r: [f32; BINS], frac: f32, seed: u32) -> [f32; BINS] {
+        let mut x = seed;
+        let mut uniform = || {
+            x = x.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);
+            (x >> 8) as f32 / (1u32 << 24) as f32
+        };
+        for v in r.iter_mut().filter(|v| **v > 0.0) {
+            let z: f32 = (0..12).map(|_| uniform()).sum::<f32>() - 6.0;
+            *v += (0.005 + frac * *v) * z;
+        }
+        r
+    }
+
+    #[test]
+    fn bins_and_pillars_are_round_boxes_are_not() {
+        let at = Pose2::IDENTITY;
+        for seed in 1..6 {
+            // A bin (r 0.15) and a round pillar (r 0.25) at 1.2 m, with the annex's noise
+            // (σ = 5 mm + 0.6 %).
+            for (c, rad) in [
+                (Point2::new(1.2, 0.3), 0.15),
+                (Point2::new(1.0, -0.5), 0.25),
+            ] {
+                let r = noisy(scan(Some((c, rad)), None), 0.006, seed);
+                assert!(is_round(c, &at, &r), "seed {seed}: circle r {rad}");
+            }
+            // A 0.6 × 0.4 box face-on, across a corner, and turned a little.
+            for yaw in [0.0, 0.785, 0.3, 1.2] {
+                let c = Point2::new(1.4, 0.2);
+                let r = noisy(scan(None, Some((c, 0.4, 0.6, yaw))), 0.006, seed);
+                assert!(!is_round(c, &at, &r), "seed {seed}: box at yaw {yaw}");
+            }
+        }
+    }
+
+    #[test]
+    fn noise_alone_says_nothing() {
+        // The simulator's noise (2.5 % of range) at 2.5 m swamps a bin's curve: no verdict.
+        let c = Point2::new(2.5, 0.0);
+        let r = noisy(scan(None, Some((c, 0.4, 0.6, 0.0))), 0.025, 3);
+        assert!(!is_round(c, &Pose2::IDENTITY, &r));
+        assert!(!is_round(Point2::new(f32::NAN, 0.0), &Pose2::IDENTITY, &r));
+        // Nothing near the centre.
+        assert!(!is_round(Point2::new(1.0, 1.0), &Pose2::IDENTITY, &r));
+    }
+}
