@@ -13,7 +13,7 @@ use heapless::Vec;
 use crate::class::ObjectClass;
 use crate::fusion::FrameObjects;
 use crate::geometry::{Point2, Pose2};
-use crate::sight::BINS;
+use crate::sight::{BINS, returns};
 
 /// Returns this close to the centre are the detection's, m.
 pub const NEAR_M: f32 = 0.35;
@@ -36,6 +36,11 @@ pub const MIN_CURVE_M: f32 = 0.01;
 
 /// Whether the returns of `ranges` (seen from `lidar`, map frame) near `centre` lie on an arc.
 pub fn is_round(centre: Point2, lidar: &Pose2, ranges: &[f32; BINS]) -> bool {
+    is_round_in(centre, lidar, &returns(ranges))
+}
+
+/// [`is_round`] on the revolution's returns already converted ([`returns`]).
+fn is_round_in(centre: Point2, lidar: &Pose2, pts: &[Option<Point2>; BINS]) -> bool {
     if !(centre.x.is_finite() && centre.y.is_finite()) {
         return false;
     }
@@ -53,9 +58,7 @@ pub fn is_round(centre: Point2, lidar: &Pose2, ranges: &[f32; BINS]) -> bool {
     let mut best: Vec<Point2, MAX_NEAR> = Vec::new();
     let mut run: Vec<Point2, MAX_NEAR> = Vec::new();
     for k in 0..BINS {
-        let d = (start + k) % BINS;
-        let r = ranges[d];
-        let p = (r > 0.0 && r.is_finite()).then(|| Point2::from_polar(r, (d as f32).to_radians()));
+        let p = pts[(start + k) % BINS];
         match p.filter(|p| p.distance(c) <= NEAR_M) {
             Some(p) if run.last().is_none_or(|q| q.distance(p) <= link) => {
                 let _ = run.push(p);
@@ -67,7 +70,7 @@ pub fn is_round(centre: Point2, lidar: &Pose2, ranges: &[f32; BINS]) -> bool {
                 run.clear();
                 let _ = run.push(p);
             }
-            None if r > 0.0 && r.is_finite() => {
+            None if p.is_some() => {
                 if run.len() > best.len() {
                     best = run.clone();
                 }
@@ -185,7 +188,8 @@ fn circle(pts: &[Point2]) -> Option<(Point2, f32, f32)> {
 /// Drops the boxes of `objects` whose returns lie on an arc ([`is_round`]); returns how many.
 pub fn drop_round_boxes(objects: &mut FrameObjects, lidar: &Pose2, ranges: &[f32; BINS]) -> u32 {
     let before = objects.len();
-    objects.retain(|o| o.class != ObjectClass::Box || !is_round(o.centre, lidar, ranges));
+    let pts = returns(ranges);
+    objects.retain(|o| o.class != ObjectClass::Box || !is_round_in(o.centre, lidar, &pts));
     (before - objects.len()) as u32
 }
 

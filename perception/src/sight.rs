@@ -6,6 +6,18 @@ use crate::geometry::{Point2, Pose2};
 /// Bins of a revolution (1° each, counter-clockwise from the LiDAR's forward axis).
 pub const BINS: usize = 360;
 
+/// A revolution's returns as points in the LiDAR's frame (bin `d` at `d`°), converted once
+/// for the checks that look at many detections; `None` where a bin has no return.
+pub fn returns(ranges: &[f32; BINS]) -> [Option<Point2>; BINS] {
+    let mut out = [None; BINS];
+    for (d, (slot, &r)) in out.iter_mut().zip(ranges.iter()).enumerate() {
+        if r > 0.0 && r.is_finite() {
+            *slot = Some(Point2::from_polar(r, (d as f32).to_radians()));
+        }
+    }
+    out
+}
+
 /// What a revolution showed of a footprint.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]

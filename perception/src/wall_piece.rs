@@ -10,7 +10,7 @@
 use crate::class::ObjectClass;
 use crate::fusion::FrameObjects;
 use crate::geometry::{Point2, Pose2};
-use crate::sight::BINS;
+use crate::sight::{BINS, returns};
 use heapless::Vec;
 
 /// Returns this close to a detection's centre are its own, m.
@@ -53,6 +53,11 @@ pub const CONTINUE_POINTS: u32 = 4;
 /// Whether the detection centred at `centre` (map frame) is a piece of a wall, given the
 /// revolution `ranges` seen from `lidar` (map frame).
 pub fn is_wall_piece(centre: Point2, lidar: &Pose2, ranges: &[f32; BINS]) -> bool {
+    is_wall_piece_in(centre, lidar, &returns(ranges))
+}
+
+/// [`is_wall_piece`] on the revolution's returns already converted ([`returns`]).
+fn is_wall_piece_in(centre: Point2, lidar: &Pose2, pts: &[Option<Point2>; BINS]) -> bool {
     if !(centre.x.is_finite() && centre.y.is_finite()) {
         return false;
     }
@@ -60,13 +65,7 @@ pub fn is_wall_piece(centre: Point2, lidar: &Pose2, ranges: &[f32; BINS]) -> boo
     let c = lidar.inverse().transform(centre);
     let two_sigma = 2.0 * NOISE_FRAC * c.norm();
     let (thin, on_line) = (THIN_M.max(two_sigma), ON_LINE_M.max(two_sigma));
-    let points = || {
-        ranges
-            .iter()
-            .enumerate()
-            .filter(|&(_, &r)| r > 0.0 && r.is_finite())
-            .map(|(d, &r)| Point2::from_polar(r, (d as f32).to_radians()))
-    };
+    let points = || pts.iter().flatten().copied();
     // Pass 1: the returns near the centre, in bearing order.
     let mut near: Vec<Point2, MAX_NEAR> = Vec::new();
     for p in points().filter(|p| p.distance(c) <= NEAR_M) {
@@ -213,8 +212,9 @@ fn dot(a: Point2, b: Point2) -> f32 {
 /// how many. Door frames live in wall lines and are exempt.
 pub fn drop_wall_pieces(objects: &mut FrameObjects, lidar: &Pose2, ranges: &[f32; BINS]) -> u32 {
     let before = objects.len();
+    let pts = returns(ranges);
     objects
-        .retain(|o| o.class == ObjectClass::DoorFrame || !is_wall_piece(o.centre, lidar, ranges));
+        .retain(|o| o.class == ObjectClass::DoorFrame || !is_wall_piece_in(o.centre, lidar, &pts));
     (before - objects.len()) as u32
 }
 
