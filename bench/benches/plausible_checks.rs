@@ -16,6 +16,7 @@ use perception::class::ObjectClass;
 use perception::fusion::{Evidence, FrameObject, FrameObjects};
 use perception::geometry::{Point2, Pose2};
 use perception::outline::drop_round_boxes;
+use perception::sight::returns;
 use perception::wall_piece::drop_wall_pieces;
 use std::hint::black_box;
 
@@ -152,8 +153,9 @@ fn bench(c: &mut Criterion) {
     g.bench_function("umbra wall_piece + outline, 24 detections", |b| {
         b.iter(|| {
             let mut o = objects.clone();
-            let n = drop_wall_pieces(&mut o, &Pose2::IDENTITY, black_box(&ranges))
-                + drop_round_boxes(&mut o, &Pose2::IDENTITY, black_box(&ranges));
+            let pts = returns(black_box(&ranges));
+            let n = drop_wall_pieces(&mut o, &Pose2::IDENTITY, &pts)
+                + drop_round_boxes(&mut o, &Pose2::IDENTITY, &pts);
             black_box(n)
         })
     });

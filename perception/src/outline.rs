@@ -186,10 +186,14 @@ fn circle(pts: &[Point2]) -> Option<(Point2, f32, f32)> {
 }
 
 /// Drops the boxes of `objects` whose returns lie on an arc ([`is_round`]); returns how many.
-pub fn drop_round_boxes(objects: &mut FrameObjects, lidar: &Pose2, ranges: &[f32; BINS]) -> u32 {
+/// `pts`: the revolution's returns, converted once a frame ([`returns`]).
+pub fn drop_round_boxes(
+    objects: &mut FrameObjects,
+    lidar: &Pose2,
+    pts: &[Option<Point2>; BINS],
+) -> u32 {
     let before = objects.len();
-    let pts = returns(ranges);
-    objects.retain(|o| o.class != ObjectClass::Box || !is_round_in(o.centre, lidar, &pts));
+    objects.retain(|o| o.class != ObjectClass::Box || !is_round_in(o.centre, lidar, pts));
     (before - objects.len()) as u32
 }
 

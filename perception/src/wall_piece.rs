@@ -209,12 +209,16 @@ fn dot(a: Point2, b: Point2) -> f32 {
 }
 
 /// Drops the furniture of `objects` that is a piece of a wall ([`is_wall_piece`]); returns
-/// how many. Door frames live in wall lines and are exempt.
-pub fn drop_wall_pieces(objects: &mut FrameObjects, lidar: &Pose2, ranges: &[f32; BINS]) -> u32 {
+/// how many. Door frames live in wall lines and are exempt. `pts`: the revolution's returns,
+/// converted once a frame ([`returns`]) for this check and the others.
+pub fn drop_wall_pieces(
+    objects: &mut FrameObjects,
+    lidar: &Pose2,
+    pts: &[Option<Point2>; BINS],
+) -> u32 {
     let before = objects.len();
-    let pts = returns(ranges);
     objects
-        .retain(|o| o.class == ObjectClass::DoorFrame || !is_wall_piece_in(o.centre, lidar, &pts));
+        .retain(|o| o.class == ObjectClass::DoorFrame || !is_wall_piece_in(o.centre, lidar, pts));
     (before - objects.len()) as u32
 }
 

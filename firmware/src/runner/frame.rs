@@ -323,9 +323,11 @@ impl<S: RevolutionStream> FrameLoop<'_, S> {
         }
         // Nor is a detection whose returns lie on a line that goes on as a wall does.
         let lidar = midway(&pose.start, &pose.end).compose(&mount);
-        st.walled += u64::from(drop_wall_pieces(&mut st.fused, &lidar, st.history.newest()));
+        // The revolution as points, once, for this check and the next.
+        let returns = perception::sight::returns(st.history.newest());
+        st.walled += u64::from(drop_wall_pieces(&mut st.fused, &lidar, &returns));
         // A "box" whose returns lie on an arc is a bin or a round pillar.
-        st.walled += u64::from(drop_round_boxes(&mut st.fused, &lidar, st.history.newest()));
+        st.walled += u64::from(drop_round_boxes(&mut st.fused, &lidar, &returns));
         st.detections.clear();
         for (id, o) in st.fused.iter().enumerate() {
             st.detections.push(ObjectOut::new(id, o));
