@@ -24,6 +24,16 @@ impl Point2 {
         Point2::new(range * libm::cosf(angle), range * libm::sinf(angle))
     }
 
+    /// Dot product with `other`.
+    pub fn dot(self, other: Point2) -> f32 {
+        self.x * other.x + self.y * other.y
+    }
+
+    /// The z component of the cross product with `other` (positive: `other` is to the left).
+    pub fn cross(self, other: Point2) -> f32 {
+        self.x * other.y - self.y * other.x
+    }
+
     /// Euclidean length.
     pub fn norm(self) -> f32 {
         libm::hypotf(self.x, self.y)

@@ -21,10 +21,11 @@
 //! | [`yolo`]       | Method B's output: YOLOv8 decode, suppression, map-frame centres |
 //! | [`plausible`]  | furniture that cannot be: centres in or behind a wall seen this revolution |
 //! | [`wall_map`]   | the map's wall lines, gathered over revolutions; what lies in a wall's band |
+//! | [`map_doors`]  | doorways in the map's walls that this revolution's rays pass through |
 //! | [`wall_piece`] | a detection whose returns lie on a line that goes on as a wall does |
 //! | [`outline`]    | a "box" whose returns lie on an arc (a bin, a round pillar) |
 //! | [`fusion`]     | one frame's objects from both methods: A's, and B's joined or added |
-//! | [`sight`]      | what a revolution showed of a footprint: hidden, in view, seen empty |
+//! | [`sight`]      | what a revolution showed of a footprint (hidden, in view, seen empty) or a doorway |
 //! | [`motion`]     | a track's alpha–beta motion filter; walking legs told from furniture |
 //! | [`tracks`]     | the world model's tracks: stable ids, association, evidence, negative evidence |
 //!
@@ -40,6 +41,7 @@ pub mod doors;
 pub mod features;
 pub mod fusion;
 pub mod geometry;
+pub mod map_doors;
 pub mod merge;
 pub mod method_a;
 pub mod motion;

@@ -1,5 +1,6 @@
 //! What one revolution showed of a footprint in the map: hidden, in plain view, or seen empty
-//! (every ray across it returned from beyond). The world model's negative evidence. `no_std`.
+//! (every ray across it returned from beyond); and of a doorway, which rays passing through
+//! do not speak against. The world model's negative evidence. `no_std`.
 
 use crate::geometry::{Point2, Pose2};
 
@@ -64,5 +65,44 @@ pub fn view(centre: Point2, r: f32, lidar: &Pose2, ranges: &[f32; BINS], max_ran
         View::Plain
     } else {
         View::Hidden
+    }
+}
+
+/// What a revolution showed of a doorway (an opening in a wall between two jambs).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum DoorView {
+    /// Out of range or behind something nearer.
+    Hidden,
+    /// Rays pass through its middle, or its jambs are in plain view: what a doorway looks like.
+    Open,
+    /// Rays end in its middle: a shut door, or a wall where no doorway is.
+    Closed,
+    /// Rays pass through its middle and where its jambs should be: open floor, no doorway.
+    NoJambs,
+}
+
+/// Half the middle of a doorway looked at for [`DoorView::Closed`], m: inside the narrowest
+/// doorway's half-width (0.75 m / 2), so its jambs are never in it.
+pub const DOOR_MIDDLE_M: f32 = 0.2;
+/// How far past a doorway's half-width its jambs are looked for, m.
+pub const DOOR_JAMB_M: f32 = 0.2;
+
+/// What this revolution showed of a doorway centred at `centre` whose jambs stand `half_width`
+/// m either side of it.
+pub fn doorway_view(
+    centre: Point2,
+    half_width: f32,
+    lidar: &Pose2,
+    ranges: &[f32; BINS],
+    max_range_m: f32,
+) -> DoorView {
+    let middle = view(centre, DOOR_MIDDLE_M, lidar, ranges, max_range_m);
+    let whole = view(centre, half_width + DOOR_JAMB_M, lidar, ranges, max_range_m);
+    match (middle, whole) {
+        (View::Plain, _) => DoorView::Closed,
+        (_, View::Empty) => DoorView::NoJambs,
+        (View::Hidden, View::Hidden) => DoorView::Hidden,
+        _ => DoorView::Open,
     }
 }

@@ -13,8 +13,11 @@
 //!    method saw it.
 //! 3. **Negative evidence** for every unmatched track in range: when the revolution's rays
 //!    across the track's footprint all returned from beyond it, the place was seen empty and
-//!    existence falls by `free_loss`. Rays that end inside the footprint (a chair's legs) or
-//!    before it (something in front) say nothing.
+//!    existence falls by `free_loss`; in plain view and not observed, by `miss_loss`. Rays
+//!    that end before it (something in front) say nothing. A door frame the map's walls showed
+//!    as a doorway ([`Tracks::anchor_doors`]) is an opening: rays through it are what it looks
+//!    like; it loses belief when its middle is seen closed, or when the rays pass its jambs'
+//!    places too (open floor).
 //! 4. **New tracks** from unmatched observations (non-finite or absurd ones are refused and
 //!    counted); when the table is full the weakest tentative track, else the weakest track, is
 //!    evicted (counted).
@@ -35,7 +38,7 @@ use crate::class::ObjectClass;
 use crate::fusion::{Evidence, FrameObject};
 use crate::geometry::{Point2, Pose2};
 use crate::motion::{Motion, MotionConfig};
-use crate::sight::{BINS, View, view};
+use crate::sight::{BINS, DoorView, View, doorway_view, view};
 
 /// Tracks held at most.
 pub const MAX_TRACKS: usize = 64;
@@ -140,6 +143,9 @@ pub struct Track {
     pub width_m: f32,
     /// Position and velocity from the observations alone; whether it walks.
     pub motion: Motion,
+    /// A door frame the map's walls have shown as a doorway (a gap seen through): an opening
+    /// in a wall, which rays passing through do not speak against.
+    pub anchored: bool,
 }
 
 impl Track {
@@ -378,12 +384,29 @@ impl Tracks {
                 if matched[i] {
                     continue;
                 }
-                let loss = match view(t.centre, t.radius(), lidar, ranges, cfg.max_range_m) {
-                    View::Empty => cfg.free_loss,
-                    View::Plain => cfg.miss_loss,
-                    View::Hidden => 0.0,
+                let (loss, in_view) = if t.class() == ObjectClass::DoorFrame && t.anchored {
+                    // An opening in a wall: seen through is what it looks like.
+                    let jambs = if t.width_m > 0.0 {
+                        0.5 * t.width_m
+                    } else {
+                        t.radius()
+                    };
+                    match doorway_view(t.centre, jambs, lidar, ranges, cfg.max_range_m) {
+                        DoorView::Closed => (cfg.miss_loss, true),
+                        DoorView::NoJambs => (cfg.free_loss, true),
+                        // In view all the same: a one-method door must be seen at its rate.
+                        DoorView::Open => (0.0, true),
+                        DoorView::Hidden => (0.0, false),
+                    }
+                } else {
+                    let loss = match view(t.centre, t.radius(), lidar, ranges, cfg.max_range_m) {
+                        View::Empty => cfg.free_loss,
+                        View::Plain => cfg.miss_loss,
+                        View::Hidden => 0.0,
+                    };
+                    (loss, loss > 0.0)
                 };
-                if loss > 0.0 {
+                if in_view {
                     t.views = t.views.saturating_add(1);
                 }
                 t.existence = (t.existence - loss).max(-cfg.existence_cap);
@@ -431,6 +454,7 @@ impl Tracks {
                 confirmed: false,
                 width_m: 0.0,
                 motion: Motion::new(o.centre, stamp_s),
+                anchored: false,
             };
             Self::hit(&mut t, o, frame, stamp_s, cfg);
             if self.tracks.push(t).is_ok() {
@@ -528,6 +552,7 @@ impl Tracks {
                 if t.width_m <= 0.0 {
                     t.width_m = gone.width_m;
                 }
+                t.anchored |= gone.anchored;
                 self.tracks.swap_remove(g);
                 self.stats.merged += 1;
                 if g == i {
@@ -536,6 +561,20 @@ impl Tracks {
                 }
             }
             i += 1;
+        }
+    }
+
+    /// Door-frame tracks within their footprint of a doorway the map's walls showed this
+    /// revolution ([`crate::map_doors::observe`]) are openings in a wall from now on.
+    pub fn anchor_doors(&mut self, doorways: &[Point2]) {
+        for t in self.tracks.iter_mut() {
+            if t.class() == ObjectClass::DoorFrame
+                && doorways
+                    .iter()
+                    .any(|d| d.distance(t.centre) <= class_radius(ObjectClass::DoorFrame))
+            {
+                t.anchored = true;
+            }
         }
     }
 
@@ -832,6 +871,74 @@ mod test {
             &cfg,
         );
         assert_eq!(t.all().len(), 2);
+    }
+
+    #[test]
+    fn a_doorway_seen_through_stays_and_one_seen_shut_goes() {
+        let cfg = quick();
+        let mut t = Tracks::new();
+        // A doorway 2 m ahead, 0.9 m wide: its jambs end the rays at ±13°, the rays between
+        // them return from the next room.
+        let mut open = ranges(4.0);
+        for d in [12, 13, 14, 15, 345, 346, 347, 348] {
+            open[d] = 2.05;
+        }
+        let door = obs(ObjectClass::DoorFrame, 2.0, 0.0, 0.9, Evidence::AB);
+        for f in 0..5 {
+            step(&mut t, f, &[door], &Pose2::IDENTITY, &open, &cfg);
+        }
+        assert_eq!(t.confirmed().count(), 1);
+        // The map's walls show a doorway there.
+        let doorway = [Point2::new(2.0, 0.05)];
+        t.anchor_doors(&doorway);
+        // Not detected for 20 s, in plain view and open: still a door.
+        for f in 5..105 {
+            step(&mut t, f, &[], &Pose2::IDENTITY, &open, &cfg);
+        }
+        assert_eq!(
+            t.confirmed().count(),
+            1,
+            "an open doorway is not seen empty"
+        );
+        // Shut: the rays end on the door's line.
+        let shut = ranges(2.0);
+        for f in 105..125 {
+            step(&mut t, f, &[], &Pose2::IDENTITY, &shut, &cfg);
+        }
+        assert_eq!(t.all().len(), 0, "a shut door leaves the map");
+
+        // A "door frame" on open floor: the rays pass where its jambs would be too.
+        let mut t = Tracks::new();
+        for f in 0..5 {
+            step(&mut t, f, &[door], &Pose2::IDENTITY, &open, &cfg);
+        }
+        t.anchor_doors(&doorway);
+        let floor = ranges(4.0);
+        for f in 5..25 {
+            step(&mut t, f, &[], &Pose2::IDENTITY, &floor, &cfg);
+        }
+        assert_eq!(t.all().len(), 0, "no jambs, no doorway");
+
+        // One method's door seen in every other frame it was in view: below the rate.
+        let mut t = Tracks::new();
+        let b_door = obs(ObjectClass::DoorFrame, 2.0, 0.0, 0.9, Evidence::B);
+        for f in 0..20 {
+            let seen: &[FrameObject] = if f % 2 == 0 { &[b_door] } else { &[] };
+            step(&mut t, f, seen, &Pose2::IDENTITY, &open, &cfg);
+            t.anchor_doors(&doorway);
+        }
+        assert_eq!(t.confirmed().count(), 0, "a flickering one-method door");
+
+        // A door frame the map's walls never showed as a doorway (a reflex corner, say) is
+        // judged like furniture: its place seen empty, it goes.
+        let mut t = Tracks::new();
+        for f in 0..5 {
+            step(&mut t, f, &[door], &Pose2::IDENTITY, &open, &cfg);
+        }
+        for f in 5..25 {
+            step(&mut t, f, &[], &Pose2::IDENTITY, &floor, &cfg);
+        }
+        assert_eq!(t.all().len(), 0, "not anchored, seen empty");
     }
 
     #[test]

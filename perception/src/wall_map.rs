@@ -74,12 +74,18 @@ impl MapWall {
         self.hi - self.lo
     }
 
+    /// Its extent along the line, `(lo, hi)` m from the origin.
+    pub(crate) fn extent(&self) -> (f32, f32) {
+        (self.lo, self.hi)
+    }
+
     /// Seen often enough to hold anything.
     pub fn confirmed(&self) -> bool {
         self.support >= CONFIRM_FRAMES && self.side != 0
     }
 
-    fn at(&self, u: f32) -> Point2 {
+    /// The point `u` m along the line from its origin.
+    pub(crate) fn at(&self, u: f32) -> Point2 {
         Point2::new(
             self.origin.x + u * self.dir.x,
             self.origin.y + u * self.dir.y,
@@ -87,28 +93,28 @@ impl MapWall {
     }
 
     /// Position along the line.
-    fn along(&self, p: Point2) -> f32 {
-        dot(p - self.origin, self.dir)
+    pub(crate) fn along(&self, p: Point2) -> f32 {
+        (p - self.origin).dot(self.dir)
     }
 
     /// Signed distance from the face, positive on the room's side.
-    fn in_front(&self, p: Point2) -> f32 {
-        dot(p - self.origin, self.room_normal())
+    pub(crate) fn in_front(&self, p: Point2) -> f32 {
+        (p - self.origin).dot(self.room_normal())
     }
 
     /// Whether the segment `a`–`b`, whose room lies along `room` (a normal; zero: unknown),
     /// continues this line. The two faces of a thin wall are two lines: their rooms differ.
     fn continued_by(&self, a: Point2, b: Point2, room: Point2) -> bool {
-        if self.side != 0 && dot(room, self.room_normal()) < 0.0 {
+        if self.side != 0 && room.dot(self.room_normal()) < 0.0 {
             return false;
         }
         let d = unit(b - a);
-        if libm::fabsf(cross(self.dir, d)) > libm::sinf(SAME_ANGLE_RAD) {
+        if libm::fabsf(self.dir.cross(d)) > libm::sinf(SAME_ANGLE_RAD) {
             return false;
         }
         let n = Point2::new(-self.dir.y, self.dir.x);
-        if libm::fabsf(dot(a - self.origin, n)) > SAME_OFFSET_M
-            || libm::fabsf(dot(b - self.origin, n)) > SAME_OFFSET_M
+        if libm::fabsf((a - self.origin).dot(n)) > SAME_OFFSET_M
+            || libm::fabsf((b - self.origin).dot(n)) > SAME_OFFSET_M
         {
             return false;
         }
@@ -120,7 +126,7 @@ impl MapWall {
     /// Takes in the segment `a`–`b` with weight `w` (its side is voted apart).
     fn absorb(&mut self, a: Point2, b: Point2, w: f32) {
         let mut d = unit(b - a);
-        if dot(d, self.dir) < 0.0 {
+        if d.dot(self.dir) < 0.0 {
             d = Point2::new(-d.x, -d.y);
         }
         let w0 = (self.support as f32).min(MAX_WEIGHT);
@@ -150,28 +156,20 @@ impl MapWall {
     }
 
     /// The unit normal on the room's side.
-    fn room_normal(&self) -> Point2 {
+    pub(crate) fn room_normal(&self) -> Point2 {
         let s = if self.side >= 0 { 1.0 } else { -1.0 };
         Point2::new(-self.dir.y * s, self.dir.x * s)
     }
 
     fn vote(&mut self, sensor: Point2) {
         let n = Point2::new(-self.dir.y, self.dir.x);
-        let s = dot(sensor - self.origin, n);
+        let s = (sensor - self.origin).dot(n);
         if s > 0.0 {
             self.side = (self.side + 1).min(MAX_SIDE_VOTES);
         } else if s < 0.0 {
             self.side = (self.side - 1).max(-MAX_SIDE_VOTES);
         }
     }
-}
-
-fn dot(a: Point2, b: Point2) -> f32 {
-    a.x * b.x + a.y * b.y
-}
-
-fn cross(a: Point2, b: Point2) -> f32 {
-    a.x * b.y - a.y * b.x
 }
 
 fn unit(v: Point2) -> Point2 {
@@ -251,7 +249,7 @@ impl WallMap {
         // The room is on the side the LiDAR stood.
         let d = unit(b - a);
         let mut room = Point2::new(-d.y, d.x);
-        if dot(sensor - a, room) < 0.0 {
+        if (sensor - a).dot(room) < 0.0 {
             room = Point2::new(-room.x, -room.y);
         }
         let joined = self.walls.iter().position(|w| w.continued_by(a, b, room));
@@ -315,7 +313,7 @@ impl WallMap {
                     let w = &mut self.walls[i];
                     w.absorb(a, b, (other.support as f32).min(MAX_WEIGHT));
                     // The other line's votes, turned to this line's direction.
-                    let votes = if dot(w.dir, other.dir) >= 0.0 {
+                    let votes = if w.dir.dot(other.dir) >= 0.0 {
                         other.side
                     } else {
                         -other.side
@@ -356,7 +354,7 @@ impl WallMap {
                     && !self.walls.iter().any(|v| {
                         v.confirmed()
                             && within(v)
-                            && dot(v.room_normal(), w.room_normal()) < -0.9
+                            && v.room_normal().dot(w.room_normal()) < -0.9
                             && (IN_WALL_M..BEHIND_M + IN_WALL_M).contains(&v.in_front(p))
                     })
             })

@@ -91,7 +91,7 @@ fn is_wall_piece_in(centre: Point2, lidar: &Pose2, pts: &[Option<Point2>; BINS])
         let nrm = Point2::new(-e.y / e.norm(), e.x / e.norm());
         let count = near
             .iter()
-            .filter(|p| libm::fabsf(dot(**p - a, nrm)) <= thin)
+            .filter(|p| libm::fabsf((**p - a).dot(nrm)) <= thin)
             .count();
         if count < MIN_POINTS as usize || 2 * count < n {
             continue;
@@ -122,7 +122,7 @@ fn continues_as_wall<I: Iterator<Item = Point2>>(
     let inliers = || {
         near.iter()
             .copied()
-            .filter(move |p| libm::fabsf(dot(*p - a, nrm)) <= thin)
+            .filter(move |p| libm::fabsf((*p - a).dot(nrm)) <= thin)
     };
     let k = inliers().count() as f32;
     let m = inliers().fold(Point2::new(0.0, 0.0), |s, p| s + p);
@@ -138,23 +138,23 @@ fn continues_as_wall<I: Iterator<Item = Point2>>(
     let dir = Point2::new(libm::cosf(angle), libm::sinf(angle));
     // The normal towards the LiDAR.
     let mut nrm = Point2::new(-dir.y, dir.x);
-    if dot(Point2::new(0.0, 0.0) - m, nrm) < 0.0 {
+    if (Point2::new(0.0, 0.0) - m).dot(nrm) < 0.0 {
         nrm = Point2::new(-nrm.x, -nrm.y);
     }
-    let s = dot(c - m, nrm);
+    let s = (c - m).dot(nrm);
     if !(-BEHIND_M..=IN_FRONT_M).contains(&s) {
         return false;
     }
     // Pass 2: does the line go on beyond any furniture's size, unbroken from the returns
     // near the centre (a tilted fit through a box's face may cross a wall further on, across
     // empty floor)? Returns on it, in cells of CELL_M along it.
-    let u0 = dot(c - m, dir);
+    let u0 = (c - m).dot(dir);
     let (mut cells, mut beyond) = (0u64, 0u32);
     for p in points() {
-        if libm::fabsf(dot(p - m, nrm)) > on_line {
+        if libm::fabsf((p - m).dot(nrm)) > on_line {
             continue;
         }
-        let u = dot(p - m, dir) - u0;
+        let u = (p - m).dot(dir) - u0;
         if libm::fabsf(u) >= CONTINUES_TO_M {
             continue;
         }
@@ -168,7 +168,7 @@ fn continues_as_wall<I: Iterator<Item = Point2>>(
     }
     // The gap a wall may show: its returns' spacing at this range and incidence, a few times.
     let range = c.norm().max(0.1);
-    let cos_inc = (libm::fabsf(dot(c, nrm)) / range).max(0.2);
+    let cos_inc = (libm::fabsf(c.dot(nrm)) / range).max(0.2);
     let spacing = range * core::f32::consts::PI / 180.0 / cos_inc;
     let gap = (libm::ceilf(MAX_GAP_M.max(2.5 * spacing) / CELL_M) as u32).max(1);
     let mid = CELLS / 2;
@@ -202,10 +202,6 @@ fn continues_as_wall<I: Iterator<Item = Point2>>(
         }
     }
     last.saturating_sub(mid) >= from_cells || mid.saturating_sub(first) >= from_cells
-}
-
-fn dot(a: Point2, b: Point2) -> f32 {
-    a.x * b.x + a.y * b.y
 }
 
 /// Drops the furniture of `objects` that is a piece of a wall ([`is_wall_piece`]); returns

@@ -144,6 +144,11 @@ fn buffers_in_code() -> Vec<(&'static str, usize, usize)> {
             size_of::<perception::wall_map::MapWall>(),
         ),
         (
+            "perception::map_doors::MAX_DOORWAYS",
+            perception::map_doors::MAX_DOORWAYS,
+            size_of::<perception::geometry::Point2>(),
+        ),
+        (
             "perception::fusion::MAX_FRAME_OBJECTS",
             perception::fusion::MAX_FRAME_OBJECTS,
             size_of::<perception::fusion::FrameObject>(),

@@ -10,6 +10,7 @@ use perception::class::ObjectClass;
 use perception::cloud::Scan;
 use perception::fusion::{Evidence, FrameObjects, merge_b, push_a};
 use perception::geometry::{Point2, Pose2};
+use perception::map_doors::{Doorways, MapDoorConfig};
 use perception::method_a::{MethodA, MethodAConfig};
 use perception::outline::drop_round_boxes;
 use perception::plausible::{drop_in_map_walls, drop_walled};
@@ -323,6 +324,19 @@ impl<S: RevolutionStream> FrameLoop<'_, S> {
         }
         // Nor is a detection whose returns lie on a line that goes on as a wall does.
         let lidar = midway(&pose.start, &pose.end).compose(&mount);
+        // Doorways in the map's walls that this revolution sees through are door frames too
+        // (a door beside a short piece of wall, or in a wall one scan shows broken).
+        let doorways = if opts.method_a.is_some() {
+            perception::map_doors::observe(
+                &st.wall_map,
+                &lidar,
+                st.history.newest(),
+                &MapDoorConfig::default(),
+                &mut st.fused,
+            )
+        } else {
+            Doorways::new()
+        };
         // The revolution as points, once, for this check and the next.
         let returns = perception::sight::returns(st.history.newest());
         st.walled += u64::from(drop_wall_pieces(&mut st.fused, &lidar, &returns));
@@ -337,6 +351,8 @@ impl<S: RevolutionStream> FrameLoop<'_, S> {
             let mid_s = t + period * 0.5;
             st.tracks
                 .update(frame, mid_s, &st.fused, &lidar, st.history.newest(), cfg);
+            // Door frames in a doorway of the map's walls are openings in a wall.
+            st.tracks.anchor_doors(&doorways);
             st.people.clear();
             for p in st.tracks.people(frame, cfg) {
                 st.people.push(PersonOut::track(p));
@@ -365,7 +381,8 @@ impl<S: RevolutionStream> FrameLoop<'_, S> {
                 st.objects.push(o);
             }
         } else {
-            // Door frames Method B found where Method A found none are doors too.
+            // Door frames Method B found where Method A found none are doors too (the map's
+            // doorways only through the world model: alone they found no door more).
             for o in st.fused.iter().filter(|o| {
                 o.class == ObjectClass::DoorFrame && o.evidence == Evidence::B && o.width_m > 0.0
             }) {
