@@ -140,8 +140,10 @@ pub fn look_through(
     cfg: &MapDoorConfig,
 ) -> (u32, u32) {
     let sensor = Point2::new(lidar.x, lidar.y);
-    // Only from the room's side.
-    if (sensor - g.a).dot(g.room) <= 0.1 {
+    // Signed distance along the room normal from the sensor to the line: negative on the
+    // room's side, which is the only side looked from.
+    let to_line = (g.a - sensor).dot(g.room);
+    if to_line >= -0.1 {
         return (0, 0);
     }
     let e = g.b - g.a;
@@ -164,7 +166,6 @@ pub fn look_through(
         // The gap straddles the bins' wrap: walk from `hi` round to `lo`.
         (lo, hi) = (hi, lo + 360.0);
     }
-    let to_line = (g.a - sensor).dot(g.room);
     let (mut through, mut closed) = (0, 0);
     for d in libm::ceilf(lo) as i32..=libm::floorf(hi) as i32 {
         let phi = lidar.theta + (d as f32).to_radians();

@@ -381,8 +381,9 @@ impl<S: RevolutionStream> FrameLoop<'_, S> {
                 st.objects.push(o);
             }
         } else {
-            // Door frames Method B found where Method A found none are doors too (the map's
-            // doorways only through the world model: alone they found no door more).
+            // Door frames Method B found where Method A found none are doors too. The map's
+            // doorways reach `doors` only through the world model (here they are objects and
+            // detections only): on their own they found no door more.
             for o in st.fused.iter().filter(|o| {
                 o.class == ObjectClass::DoorFrame && o.evidence == Evidence::B && o.width_m > 0.0
             }) {
