@@ -3,11 +3,14 @@
     python training/export.py --weights runs/NAME/weights/best.pt --out models/yolo \
         [--calib DATASET/images/train --calib-images 256]
 
-Writes `umbra-yolov8n.onnx` (fp32, opset 17, simplified, static 1x3x64x384 -> 1x8x504) and,
-with `--calib`, `umbra-yolov8n-int8.onnx`: static int8, QOperator form, convolutions only
-(`QLinearConv`, per-tensor): the form tract executes in integer. QDQ is run in float by tract
-(slower than fp32), QOperator on all ops needs `QLinearSigmoid`, which tract rejects, and the
-head's final Concat must stay float (pixels and [0, 1] scores cannot share one scale).
+Writes `umbra-yolov8n.onnx` (fp32, opset 17, simplified, static 1x3x64x384 -> 1x68x504: the
+graph cut before its box decoding by `logits_head.py`; the runtime's decoder does that part)
+and, with `--calib`, `umbra-yolov8n-int8.onnx`: static int8, QOperator form, convolutions only
+(`QLinearConv`, per-tensor), the form tract executes in integer, quantised from the cut graph
+so that the DFL's expectation stays float (quantised, its uint8 probabilities moved boxes by
+up to 7 px). QDQ is run in float by tract (slower than fp32), and QOperator on all ops needs
+`QLinearSigmoid`, which tract rejects. `--full-head` keeps Ultralytics' 1x8x504 output (the
+runtime reads both forms).
 Calibration images are the first N of the folder in name order (deterministic).
 """
 
@@ -17,6 +20,7 @@ from pathlib import Path
 
 import numpy as np
 
+import logits_head
 import offline  # noqa: F401
 from ultralytics import YOLO
 
@@ -57,6 +61,8 @@ def main() -> None:
     ap.add_argument("--out", default="models/yolo")
     ap.add_argument("--calib", help="folder of PNGs for int8 calibration")
     ap.add_argument("--calib-images", type=int, default=256)
+    ap.add_argument("--full-head", action="store_true",
+                    help="keep the DFL and box decoding in the graph (1x8x504)")
     a = ap.parse_args()
     out = Path(a.out)
     out.mkdir(parents=True, exist_ok=True)
@@ -64,7 +70,10 @@ def main() -> None:
     f = model.export(format="onnx", imgsz=(64, 384), opset=17, simplify=True, dynamic=False,
                      batch=1, device="cpu")
     fp32 = out / "umbra-yolov8n.onnx"
-    shutil.copy(f, fp32)
+    if a.full_head:
+        shutil.copy(f, fp32)
+    else:
+        logits_head.cut(Path(f), fp32)
     print(f"wrote {fp32}")
     if a.calib:
         q = out / "umbra-yolov8n-int8.onnx"

@@ -4,10 +4,17 @@ environment, `.venv/bin/python training/test_training.py DATASET/data.yaml`).
 * shuffling: Ultralytics turns DataLoader shuffling off for `rect=True` when the batch shapes
   differ; ours are all 64 x 384, so it must stay on — two epochs of the trainer's own
   dataloader must see the images in different orders, every batch exactly 64 x 384.
+* the logits head: the shipped checkpoint exported with Ultralytics' full head, and the same
+  graph cut by `logits_head.py` with the DFL, anchors and sigmoid done in numpy as
+  `perception::yolo::decode` does them, give the same 1 x 8 x 504 on real rasters.
 """
 
+import shutil
 import sys
+import tempfile
 from pathlib import Path
+
+import numpy as np
 
 import offline  # noqa: F401  (must come before ultralytics)
 from exact import ExactTrainer
@@ -42,6 +49,51 @@ def test_shuffled(data: Path) -> None:
     print(f"shuffled: epoch 1 starts {a[:3]}, epoch 2 starts {b[:3]}")
 
 
+def decode_logits(lg: np.ndarray) -> np.ndarray:
+    """A 1 x 68 x 504 logits head as Ultralytics' 1 x 8 x 504 (what the Rust decoder computes)."""
+    a = lg.shape[2]
+    bins = lg[0, :64].reshape(4, 16, a)
+    e = np.exp(bins - bins.max(1, keepdims=True))
+    side = (e / e.sum(1, keepdims=True) * np.arange(16)[None, :, None]).sum(1)
+    pts, strides = [], []
+    for s, h, w in [(8, 8, 48), (16, 4, 24), (32, 2, 12)]:
+        ys, xs = np.meshgrid(np.arange(h) + 0.5, np.arange(w) + 0.5, indexing="ij")
+        pts.append(np.stack([xs.ravel(), ys.ravel()]))
+        strides.append(np.full(h * w, s))
+    p, st = np.concatenate(pts, 1), np.concatenate(strides)
+    lo, hi = p - side[:2], p + side[2:]
+    boxes = np.concatenate([(lo + hi) / 2, hi - lo]) * st
+    return np.concatenate([boxes, 1 / (1 + np.exp(-lg[0, 64:]))])[None]
+
+
+def test_logits_head(data: Path) -> None:
+    import onnxruntime as ort
+    from ultralytics import YOLO
+
+    import logits_head
+    from export import png_tensor
+
+    tmp = Path(tempfile.mkdtemp())
+    # Ultralytics writes the export beside the weights: export a copy, not the shipped file.
+    shutil.copy(HERE.parent / "models/yolo/umbra-yolov8n.pt", tmp / "full.pt")
+    full = Path(YOLO(str(tmp / "full.pt")).export(
+        format="onnx", imgsz=(64, 384), opset=17, simplify=True, dynamic=False, batch=1,
+        device="cpu"))
+    logits_head.cut(full, tmp / "cut.onnx")
+    run = {k: ort.InferenceSession(str(f), providers=["CPUExecutionProvider"])
+           for k, f in (("full", full), ("cut", tmp / "cut.onnx"))}
+    images = sorted((data.parent / "images" / "test").glob("*.png"))[:20]
+    worst = 0.0
+    for f in images:
+        x = {"images": png_tensor(f)}
+        want = run["full"].run(None, x)[0]
+        got = decode_logits(run["cut"].run(None, x)[0])
+        worst = max(worst, float(np.abs(want - got).max()))
+    assert worst < 1e-3, f"cut head differs by {worst} px"
+    print(f"logits head: {len(images)} images, largest difference {worst:.2e}")
+
+
 if __name__ == "__main__":
+    test_logits_head(Path(sys.argv[1]))
     test_shuffled(Path(sys.argv[1]))
     print("ok")

@@ -1,7 +1,9 @@
 //! Method B's network at run time: a YOLOv8n ONNX file run by `tract`.
 //!
 //! The model is parsed, checked and optimised **once** at start-up for the one concrete shape
-//! it will see (`1 × 3 × 64 × 384` `f32` in, `1 × 8 × 504` out), then run once per frame. The
+//! it will see (`1 × 3 × 64 × 384` `f32` in; out either `1 × 68 × 504`, the head's box-side bins
+//! and class logits that the shipped files give, or Ultralytics' decoded `1 × 8 × 504`: see
+//! `perception::yolo::Head`), then run once per frame. The
 //! input tensor is allocated once too: the raster is encoded straight into it
 //! ([`YoloModel::input_mut`]) and handed to tract by reference count, so no frame copies or
 //! allocates it. What tract allocates inside a run is its own business (constant per frame; a
@@ -15,7 +17,7 @@ use std::path::Path;
 use std::sync::Arc;
 
 use perception::raster::{RASTER_C, RASTER_H, RASTER_LEN, RASTER_W};
-use perception::yolo::{ANCHORS, OUTPUT_LEN, OUTPUT_ROWS};
+use perception::yolo::{ANCHORS, Head, LOGIT_ROWS, OUTPUT_ROWS};
 use tract_onnx::prelude::*;
 use tract_onnx::tract_core::internal::SimpleState;
 use tract_onnx::tract_hir::infer::Factoid;
@@ -33,8 +35,11 @@ pub const BUILTIN_NAME: &str = "<built-in umbra-yolov8n.onnx>";
 
 /// The input shape every model must accept.
 pub const INPUT_SHAPE: [usize; 4] = [1, RASTER_C, RASTER_H, RASTER_W];
-/// The output shape every model must give.
+/// The output shape of a model exported by Ultralytics (boxes decoded in the graph).
 pub const OUTPUT_SHAPE: [usize; 3] = [1, OUTPUT_ROWS, ANCHORS];
+/// The output shape of a model cut before its box decoding (`training/logits_head.py`; the
+/// shipped files).
+pub const LOGITS_SHAPE: [usize; 3] = [1, LOGIT_ROWS, ANCHORS];
 
 /// Why a model could not be loaded or run.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -62,7 +67,7 @@ pub enum ModelErrorKind {
     },
     /// The input is not `1 × 3 × 64 × 384` `f32`.
     InputShape(String),
-    /// The output is not `1 × 8 × 504`.
+    /// The output is neither `1 × 68 × 504` nor `1 × 8 × 504`.
     OutputShape(String),
     /// tract could not type or optimise the graph.
     Optimise(String),
@@ -84,7 +89,10 @@ impl fmt::Display for ModelError {
                 write!(f, "input is {s}, expected f32 {INPUT_SHAPE:?}")
             }
             ModelErrorKind::OutputShape(s) => {
-                write!(f, "output is {s}, expected f32 {OUTPUT_SHAPE:?}")
+                write!(
+                    f,
+                    "output is {s}, expected f32 {LOGITS_SHAPE:?} or {OUTPUT_SHAPE:?}"
+                )
             }
             ModelErrorKind::Optimise(e) => write!(f, "cannot prepare it for {INPUT_SHAPE:?}: {e}"),
             ModelErrorKind::Run(e) => write!(f, "inference failed: {e}"),
@@ -112,6 +120,7 @@ type Plan = Arc<TypedRunnableModel>;
 /// A loaded, optimised model with its input tensor.
 pub struct YoloModel {
     name: String,
+    head: Head,
     state: TypedSimpleState,
     input: Arc<Tensor>,
     /// Frames whose input had to be reallocated because tract still held the last one.
@@ -192,11 +201,15 @@ impl YoloModel {
         let out = typed
             .output_fact(0)
             .map_err(|e| err(ModelErrorKind::Optimise(format!("{e:#}"))))?;
-        let out_ok = out.datum_type == f32::datum_type()
-            && out.shape.as_concrete() == Some(&OUTPUT_SHAPE[..]);
-        if !out_ok {
+        let head = match out.shape.as_concrete() {
+            _ if out.datum_type != f32::datum_type() => None,
+            Some(s) if s == OUTPUT_SHAPE => Some(Head::Boxes),
+            Some(s) if s == LOGITS_SHAPE => Some(Head::Logits),
+            _ => None,
+        };
+        let Some(head) = head else {
             return Err(err(ModelErrorKind::OutputShape(format!("{out:?}"))));
-        }
+        };
         let mut options = RunOptions::default();
         if opts.threads > 1 {
             options.executor = Some(tract_linalg::multithread::Executor::multithread(
@@ -215,6 +228,7 @@ impl YoloModel {
         );
         Ok(YoloModel {
             name: name.to_string(),
+            head,
             state,
             input,
             input_reallocations: 0,
@@ -224,6 +238,11 @@ impl YoloModel {
     /// The file the model came from.
     pub fn name(&self) -> &str {
         &self.name
+    }
+
+    /// Which form of output the model gives.
+    pub fn head(&self) -> Head {
+        self.head
     }
 
     /// The input tensor's `1 × 3 × 64 × 384` floats, to encode the raster into
@@ -244,7 +263,8 @@ impl YoloModel {
         s
     }
 
-    /// Runs the network on the current input; calls `f` with the `8 × 504` output floats.
+    /// Runs the network on the current input; calls `f` with the output floats
+    /// ([`Self::head`]`.rows()` × 504, what `perception::yolo::decode` reads).
     pub fn run<R>(&mut self, f: impl FnOnce(&[f32]) -> R) -> Result<R, ModelError> {
         let err = |e: TractError| ModelError {
             file: self.name.clone(),
@@ -256,7 +276,7 @@ impl YoloModel {
             .map_err(err)?;
         let view = outputs[0].to_plain_array_view::<f32>().map_err(err)?;
         let out = view.as_slice().unwrap_or(&[]);
-        if out.len() != OUTPUT_LEN {
+        if out.len() != self.head.rows() * ANCHORS {
             return Err(ModelError {
                 file: self.name.clone(),
                 kind: ModelErrorKind::OutputShape(format!("{:?}", outputs[0].shape())),
@@ -294,7 +314,12 @@ mod test {
         let mut m = YoloModel::builtin(YoloOptions::default()).unwrap();
         m.input_mut().fill(0.0);
         let n = m.run(|o| o.len()).unwrap();
-        assert_eq!(n, OUTPUT_LEN);
+        assert_eq!(
+            m.head(),
+            Head::Logits,
+            "the shipped file is cut before its DFL"
+        );
+        assert_eq!(n, perception::yolo::LOGITS_LEN);
         m.input_mut()[0] = 1.0;
         m.run(|_| ()).unwrap();
         assert_eq!(m.input_reallocations(), 0, "tract must give the input back");
@@ -304,7 +329,9 @@ mod test {
     fn quantised_model_loads() {
         let mut m =
             YoloModel::from_bytes(BUILTIN_INT8_ONNX, "int8", YoloOptions::default()).unwrap();
-        m.run(|o| assert_eq!(o.len(), OUTPUT_LEN)).unwrap();
+        assert_eq!(m.head(), Head::Logits);
+        m.run(|o| assert_eq!(o.len(), perception::yolo::LOGITS_LEN))
+            .unwrap();
     }
 
     #[test]
@@ -333,6 +360,19 @@ mod test {
             YoloModel::load(&dir.join("wrong-output.onnx"), YoloOptions::default()).unwrap_err();
         assert!(matches!(e.kind, ModelErrorKind::OutputShape(_)), "{e}");
         assert!(e.to_string().contains("wrong-output.onnx"), "{e}");
+    }
+
+    #[test]
+    fn a_model_in_ultralytics_own_form_still_loads() {
+        let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("yolo/testdata");
+        let mut m = YoloModel::load(&dir.join("boxes-form.onnx"), YoloOptions::default()).unwrap();
+        assert_eq!(m.head(), Head::Boxes);
+        for (i, x) in m.input_mut().iter_mut().enumerate() {
+            *x = i as f32;
+        }
+        let out = m.run(|o| o.to_vec()).unwrap();
+        assert_eq!(out.len(), perception::yolo::OUTPUT_LEN);
+        assert!(out.iter().enumerate().all(|(i, &x)| x == i as f32));
     }
 
     #[test]

@@ -4,11 +4,22 @@
 //!
 //! ## The output tensor
 //!
-//! A YOLOv8 detection head exported by Ultralytics gives `(1, 4 + NC, A)` floats, row-major:
-//! rows 0–3 are the box centre x, centre y, width and height in **input pixels** (384 × 64),
-//! rows 4.. the per-class scores with the sigmoid already applied; there is no objectness row.
-//! For our 64 × 384 input and strides 8, 16, 32 there are [`ANCHORS`] = 8·48 + 4·24 + 2·12 = 504
-//! columns. The value of row `k`, anchor `a` is at `k · A + a`.
+//! [`decode`] reads either of two forms of a YOLOv8 detection head, told apart by the tensor's
+//! length ([`Head`]); both are row-major `(1, rows, A)` floats, the value of row `k`, anchor `a`
+//! at `k · A + a`. For our 64 × 384 input and strides 8, 16, 32 there are [`ANCHORS`] =
+//! 8·48 + 4·24 + 2·12 = 504 anchors, level by level, each level's grid row by row.
+//!
+//! - [`Head::Boxes`], Ultralytics' own export: `4 + NC` rows. Rows 0–3 are the box centre x,
+//!   centre y, width and height in **input pixels** (384 × 64), rows 4.. the per-class scores
+//!   with the sigmoid already applied; there is no objectness row.
+//! - [`Head::Logits`], the same graph cut before its box decoding (`training/logits_head.py`,
+//!   what the runtime ships): `4 · 16 + NC` rows. Rows `16·s .. 16·s + 16` are the logits of
+//!   the distance from the anchor's centre to box side `s` (left, top, right, bottom) over
+//!   [`DFL_BINS`] bins of one stride each, the rows after them the class logits. The decoder
+//!   does what the graph did — the softmax's expectation per side (YOLOv8's "DFL"), the
+//!   anchor arithmetic, the sigmoid — and only for the anchors above the score threshold.
+//!   tract runs the graph's own DFL softmax, whose axis is not the last, on a slow generic
+//!   path (29 % of the model's time, `docs/method-b.md`); here it is a few hundred `expf`s.
 //!
 //! ## Suppression, as Ultralytics does it
 //!
@@ -50,6 +61,81 @@ pub const OUTPUT_LEN: usize = OUTPUT_ROWS * ANCHORS;
 pub const MAX_RAW_CANDIDATES: usize = ANCHORS * NUM_CLASSES;
 /// Detections the runtime keeps per frame.
 pub const MAX_DETECTIONS: usize = 32;
+/// Bins of each box side's distance distribution (YOLOv8's `reg_max`).
+pub const DFL_BINS: usize = 16;
+/// Rows of a [`Head::Logits`] tensor: 4 sides × [`DFL_BINS`], then the class logits.
+pub const LOGIT_ROWS: usize = 4 * DFL_BINS + NUM_CLASSES;
+/// Floats in a [`Head::Logits`] tensor, the largest [`decode`] reads.
+pub const LOGITS_LEN: usize = LOGIT_ROWS * ANCHORS;
+/// The anchor grid's levels as (stride, rows, columns), in the tensor's order.
+const LEVELS: [(usize, usize, usize); 3] = [
+    (8, RASTER_H / 8, RASTER_W / 8),
+    (16, RASTER_H / 16, RASTER_W / 16),
+    (32, RASTER_H / 32, RASTER_W / 32),
+];
+
+/// The two forms of detection head [`decode`] reads (module docs).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum Head {
+    /// Boxes in pixels and class probabilities: [`OUTPUT_ROWS`] rows.
+    Boxes,
+    /// Box-side bins and class logits: [`LOGIT_ROWS`] rows, for the 64 × 384 grid only.
+    Logits,
+}
+
+impl Head {
+    /// Rows of this form's tensor.
+    pub const fn rows(self) -> usize {
+        match self {
+            Head::Boxes => OUTPUT_ROWS,
+            Head::Logits => LOGIT_ROWS,
+        }
+    }
+
+    /// The form of a tensor of `len` floats over `anchors` anchors, if it is one.
+    pub fn of(len: usize, anchors: usize) -> Option<Head> {
+        if len == OUTPUT_ROWS * anchors {
+            Some(Head::Boxes)
+        } else if anchors == ANCHORS && len == LOGITS_LEN {
+            Some(Head::Logits)
+        } else {
+            None
+        }
+    }
+}
+
+/// Centre x, y (px) and stride of anchor `a` of the 64 × 384 grid.
+fn anchor_point(a: usize) -> (f32, f32, f32) {
+    let mut rest = a;
+    for (stride, rows, cols) in LEVELS {
+        if rest < rows * cols {
+            let s = stride as f32;
+            let (y, x) = (rest / cols, rest % cols);
+            return ((x as f32 + 0.5) * s, (y as f32 + 0.5) * s, s);
+        }
+        rest -= rows * cols;
+    }
+    // Callers pass a < ANCHORS; a point off the grid decodes to nothing useful but no panic.
+    (f32::NAN, f32::NAN, 0.0)
+}
+
+/// The expected bin of one side's logits `z` (softmax, then Σ j·p_j), in strides.
+fn expected_bin(z: impl Fn(usize) -> f32) -> f32 {
+    let m = (0..DFL_BINS).map(&z).fold(f32::NEG_INFINITY, f32::max);
+    let (mut sum, mut weighted) = (0.0f32, 0.0f32);
+    for j in 0..DFL_BINS {
+        let e = libm::expf(z(j) - m);
+        sum += e;
+        weighted += j as f32 * e;
+    }
+    weighted / sum
+}
+
+/// The logistic function.
+fn sigmoid(x: f32) -> f32 {
+    1.0 / (1.0 + libm::expf(-x))
+}
 
 /// One detected object, in raster pixels.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -155,7 +241,7 @@ impl Default for DecodeConfig {
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 #[non_exhaustive]
 pub enum DecodeError {
-    /// The slice is not `OUTPUT_ROWS × anchors` floats.
+    /// The slice is neither `OUTPUT_ROWS × anchors` nor `LOGIT_ROWS × ANCHORS` floats.
     BadLength {
         /// Floats given.
         len: usize,
@@ -171,7 +257,8 @@ impl fmt::Display for DecodeError {
         match self {
             DecodeError::BadLength { len, anchors } => write!(
                 f,
-                "YOLO output has {len} floats, expected {OUTPUT_ROWS} × {anchors}"
+                "YOLO output has {len} floats, expected {OUTPUT_ROWS} × {anchors} (boxes) \
+                 or {LOGIT_ROWS} × {ANCHORS} (box-side bins and class logits)"
             ),
             DecodeError::TooManyAnchors(a) => {
                 write!(
@@ -225,8 +312,8 @@ pub struct DecodeStats {
     pub non_finite: usize,
 }
 
-/// Decodes `output` (`OUTPUT_ROWS × anchors` floats, see the module docs) into `out` (cleared
-/// first), best score first.
+/// Decodes `output` (either [`Head`] form over `anchors` anchors, see the module docs) into
+/// `out` (cleared first), best score first.
 pub fn decode<const N: usize>(
     output: &[f32],
     anchors: usize,
@@ -238,27 +325,34 @@ pub fn decode<const N: usize>(
     if anchors > ANCHORS {
         return Err(DecodeError::TooManyAnchors(anchors));
     }
-    if output.len() != OUTPUT_ROWS * anchors {
-        return Err(DecodeError::BadLength {
-            len: output.len(),
-            anchors,
-        });
-    }
+    let head = Head::of(output.len(), anchors).ok_or(DecodeError::BadLength {
+        len: output.len(),
+        anchors,
+    })?;
+    let rows = head.rows();
+    let first_class = rows - NUM_CLASSES;
     let mut stats = DecodeStats::default();
     let at = |row: usize, a: usize| output[row * anchors + a];
     let cands = &mut scratch.candidates;
     cands.clear();
     for a in 0..anchors {
-        if (0..OUTPUT_ROWS).any(|k| !at(k, a).is_finite()) {
+        if (0..rows).any(|k| !at(k, a).is_finite()) {
             stats.non_finite += 1;
             continue;
         }
+        let mut scores = [0.0f32; NUM_CLASSES];
+        for (c, s) in scores.iter_mut().enumerate() {
+            let v = at(first_class + c, a);
+            *s = match head {
+                Head::Boxes => v,
+                Head::Logits => sigmoid(v),
+            };
+        }
         let mut push = |c: usize| {
-            let score = at(4 + c, a);
-            if score > cfg.conf {
+            if scores[c] > cfg.conf {
                 // Capacity is anchors × classes: cannot overflow.
                 let _ = cands.push(Candidate {
-                    score,
+                    score: scores[c],
                     anchor: a as u16,
                     class: c as u8,
                 });
@@ -267,8 +361,7 @@ pub fn decode<const N: usize>(
         if cfg.multi_label {
             (0..NUM_CLASSES).for_each(&mut push);
         } else {
-            let best =
-                (1..NUM_CLASSES).fold(0, |b, c| if at(4 + c, a) > at(4 + b, a) { c } else { b });
+            let best = (1..NUM_CLASSES).fold(0, |b, c| if scores[c] > scores[b] { c } else { b });
             push(best);
         }
     }
@@ -279,16 +372,32 @@ pub fn decode<const N: usize>(
             .then(x.anchor.cmp(&y.anchor))
             .then(x.class.cmp(&y.class))
     });
+    let bbox = |a: usize| -> [f32; 4] {
+        match head {
+            Head::Boxes => [at(0, a), at(1, a), at(2, a), at(3, a)],
+            Head::Logits => {
+                let side = |s: usize| expected_bin(|j| at(s * DFL_BINS + j, a));
+                let (ax, ay, stride) = anchor_point(a);
+                let (l, t, r, b) = (side(0), side(1), side(2), side(3));
+                [
+                    ax + (r - l) * 0.5 * stride,
+                    ay + (b - t) * 0.5 * stride,
+                    (l + r) * stride,
+                    (t + b) * stride,
+                ]
+            }
+        }
+    };
     let limit = cfg.max_det.min(N);
     for cand in cands.iter() {
-        let a = usize::from(cand.anchor);
+        let [cx, cy, w, h] = bbox(usize::from(cand.anchor));
         let det = Detection {
             class: ObjectClass::ALL[usize::from(cand.class)],
             score: cand.score,
-            cx: at(0, a),
-            cy: at(1, a),
-            w: at(2, a),
-            h: at(3, a),
+            cx,
+            cy,
+            w,
+            h,
         };
         let b = det.xyxy();
         let suppressed = out
@@ -440,6 +549,108 @@ mod test {
         t[ANCHORS + 3] = f32::NAN;
         let st = decode(&t, ANCHORS, &DecodeConfig::RUNTIME, &mut scratch, &mut out).unwrap();
         assert_eq!((out.len(), st.non_finite), (0, 1));
+    }
+
+    /// A logits-head tensor: for each (anchor, side distances in strides, class logits), each
+    /// side's bins put all their weight on the distance (split between two bins when it is
+    /// a half); everything else is −100, which `expf` takes to 0 beside a bin at 0.
+    fn logits(entries: &[(usize, [f32; 4], [f32; NUM_CLASSES])]) -> std::vec::Vec<f32> {
+        let mut t = std::vec![-100.0f32; LOGITS_LEN];
+        for &(a, sides, cls) in entries {
+            for (s, d) in sides.iter().enumerate() {
+                let j = *d as usize;
+                t[(s * DFL_BINS + j) * ANCHORS + a] = 0.0;
+                if d.fract() == 0.5 {
+                    t[(s * DFL_BINS + j + 1) * ANCHORS + a] = 0.0;
+                }
+            }
+            for (c, z) in cls.iter().enumerate() {
+                t[(4 * DFL_BINS + c) * ANCHORS + a] = *z;
+            }
+        }
+        t
+    }
+
+    #[test]
+    fn the_logits_head_decodes_to_the_boxes_its_bins_say() {
+        // Level 0 (stride 8), grid x 10, y 3: centre (84, 28). Sides l 2, t 1, r 3, b 1.5.
+        let a0 = 3 * 48 + 10;
+        // Level 2 (stride 32), grid x 5, y 1: centre (176, 48). Every side 1.
+        let a2 = 8 * 48 + 4 * 24 + 12 + 5;
+        let t = logits(&[
+            (a0, [2.0, 1.0, 3.0, 1.5], [2.0, -5.0, -5.0, -5.0]),
+            (a2, [1.0; 4], [-5.0, -5.0, 1.0, -5.0]),
+        ]);
+        let mut out: Vec<Detection, 8> = Vec::new();
+        let mut scratch = DecodeScratch::new();
+        let st = decode(&t, ANCHORS, &DecodeConfig::RUNTIME, &mut scratch, &mut out).unwrap();
+        assert_eq!((st.candidates, out.len()), (2, 2));
+        let chair = 1.0 / (1.0 + libm::expf(-2.0));
+        let near = |d: &Detection, want: [f32; 5]| {
+            let got = [d.score, d.cx, d.cy, d.w, d.h];
+            assert!(
+                got.iter().zip(want).all(|(g, w)| (g - w).abs() < 1e-4),
+                "{got:?} vs {want:?}"
+            );
+        };
+        assert_eq!(out[0].class, ObjectClass::Chair);
+        near(&out[0], [chair, 88.0, 30.0, 40.0, 20.0]);
+        assert_eq!(out[1].class, ObjectClass::Desk);
+        near(
+            &out[1],
+            [1.0 / (1.0 + libm::expf(-1.0)), 176.0, 48.0, 64.0, 64.0],
+        );
+        // The same boxes given in Ultralytics' form decode to the same detections.
+        let boxes = tensor(&[
+            (a0, [88.0, 30.0, 40.0, 20.0], [chair, 0.0, 0.0, 0.0]),
+            (a2, [176.0, 48.0, 64.0, 64.0], [0.0, 0.0, out[1].score, 0.0]),
+        ]);
+        let mut same: Vec<Detection, 8> = Vec::new();
+        decode(
+            &boxes,
+            ANCHORS,
+            &DecodeConfig::RUNTIME,
+            &mut scratch,
+            &mut same,
+        )
+        .unwrap();
+        for (x, y) in out.iter().zip(&same) {
+            assert_eq!((x.class, x.score), (y.class, y.score));
+            near(x, [y.score, y.cx, y.cy, y.w, y.h]);
+        }
+    }
+
+    #[test]
+    fn the_head_is_told_by_the_length() {
+        assert_eq!(Head::of(OUTPUT_LEN, ANCHORS), Some(Head::Boxes));
+        assert_eq!(Head::of(LOGITS_LEN, ANCHORS), Some(Head::Logits));
+        assert_eq!(Head::of(8 * 100, 100), Some(Head::Boxes));
+        assert_eq!(
+            Head::of(LOGIT_ROWS * 100, 100),
+            None,
+            "logits need the 64 × 384 grid"
+        );
+        assert_eq!(Head::of(LOGITS_LEN - 1, ANCHORS), None);
+        let mut out: Vec<Detection, 4> = Vec::new();
+        let mut scratch = DecodeScratch::new();
+        let mut t = logits(&[(7, [1.0; 4], [3.0, -5.0, -5.0, -5.0])]);
+        decode(&t, ANCHORS, &DecodeConfig::RUNTIME, &mut scratch, &mut out).unwrap();
+        assert_eq!(out.len(), 1);
+        t[(2 * DFL_BINS + 5) * ANCHORS + 7] = f32::INFINITY;
+        let st = decode(&t, ANCHORS, &DecodeConfig::RUNTIME, &mut scratch, &mut out).unwrap();
+        assert_eq!(
+            (out.len(), st.non_finite),
+            (0, 1),
+            "a non-finite bin skips the anchor"
+        );
+        let e = decode(
+            &t[1..],
+            ANCHORS,
+            &DecodeConfig::RUNTIME,
+            &mut scratch,
+            &mut out,
+        );
+        assert!(matches!(e, Err(DecodeError::BadLength { .. })));
     }
 
     #[test]

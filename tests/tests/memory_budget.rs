@@ -164,8 +164,8 @@ fn buffers_in_code() -> Vec<(&'static str, usize, usize)> {
             size_of::<f32>(),
         ),
         (
-            "perception::yolo::OUTPUT_LEN",
-            perception::yolo::OUTPUT_LEN,
+            "perception::yolo::LOGITS_LEN",
+            perception::yolo::LOGITS_LEN,
             size_of::<f32>(),
         ),
         (

@@ -29,7 +29,7 @@ fn method_b_frames_allocate_nothing_outside_tract() {
     let mut ours = 0;
     let mut tract = Vec::new();
     let mut found = 0;
-    let mut output: Vec<f32> = Vec::with_capacity(perception::yolo::OUTPUT_LEN);
+    let mut output: Vec<f32> = Vec::with_capacity(perception::yolo::LOGITS_LEN);
     for (n, w) in revs.windows(3).enumerate() {
         ours += counted(|| {
             encode_chw_f32(model.input_mut(), [&w[2], &w[1], &w[0]], &raster).unwrap();

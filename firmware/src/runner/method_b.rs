@@ -16,7 +16,8 @@ pub trait Network {
     fn name(&self) -> &str;
     /// The `1 × 3 × 64 × 384` input floats.
     fn input_mut(&mut self) -> &mut [f32];
-    /// Runs on the current input and calls `f` with the `8 × 504` output floats; the error is
+    /// Runs on the current input and calls `f` with the output floats (either form
+    /// `perception::yolo::decode` reads); the error is
     /// a message naming the model.
     fn run_with(&mut self, f: &mut dyn FnMut(&[f32])) -> Result<(), String>;
 }
