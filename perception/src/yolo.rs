@@ -333,26 +333,40 @@ pub fn decode<const N: usize>(
     let first_class = rows - NUM_CLASSES;
     let mut stats = DecodeStats::default();
     let at = |row: usize, a: usize| output[row * anchors + a];
+    // Anchors with a non-finite value anywhere, found row by row (contiguous reads).
+    let mut bad = [0u64; ANCHORS.div_ceil(64)];
+    for row in output.chunks_exact(anchors.max(1)) {
+        for (a, v) in row.iter().enumerate() {
+            if !v.is_finite() {
+                bad[a / 64] |= 1 << (a % 64);
+            }
+        }
+    }
+    // A logit above logit(conf) is a sigmoid above conf: the sigmoid is only taken for
+    // candidates.
+    let threshold = match head {
+        Head::Boxes => cfg.conf,
+        Head::Logits if cfg.conf <= 0.0 => f32::NEG_INFINITY,
+        Head::Logits if cfg.conf >= 1.0 => f32::INFINITY,
+        Head::Logits => libm::logf(cfg.conf / (1.0 - cfg.conf)),
+    };
     let cands = &mut scratch.candidates;
     cands.clear();
     for a in 0..anchors {
-        if (0..rows).any(|k| !at(k, a).is_finite()) {
+        if bad[a / 64] & (1 << (a % 64)) != 0 {
             stats.non_finite += 1;
             continue;
         }
-        let mut scores = [0.0f32; NUM_CLASSES];
-        for (c, s) in scores.iter_mut().enumerate() {
-            let v = at(first_class + c, a);
-            *s = match head {
-                Head::Boxes => v,
-                Head::Logits => sigmoid(v),
-            };
-        }
+        let value = |c: usize| at(first_class + c, a);
         let mut push = |c: usize| {
-            if scores[c] > cfg.conf {
+            let v = value(c);
+            if v > threshold {
                 // Capacity is anchors × classes: cannot overflow.
                 let _ = cands.push(Candidate {
-                    score: scores[c],
+                    score: match head {
+                        Head::Boxes => v,
+                        Head::Logits => sigmoid(v),
+                    },
                     anchor: a as u16,
                     class: c as u8,
                 });
@@ -361,7 +375,8 @@ pub fn decode<const N: usize>(
         if cfg.multi_label {
             (0..NUM_CLASSES).for_each(&mut push);
         } else {
-            let best = (1..NUM_CLASSES).fold(0, |b, c| if scores[c] > scores[b] { c } else { b });
+            // The sigmoid is monotonic: the best logit is the best score.
+            let best = (1..NUM_CLASSES).fold(0, |b, c| if value(c) > value(b) { c } else { b });
             push(best);
         }
     }
