@@ -148,7 +148,8 @@ pub struct Common {
     /// TOML configuration file.
     #[arg(long, value_name = "PATH")]
     pub config: Option<PathBuf>,
-    /// Method B's YOLO model (ONNX, 1×3×64×384 → 1×8×504); default: the compiled-in one.
+    /// Method B's YOLO model (ONNX, 1×3×64×384 → Ultralytics' 1×8×504 or the head's logits,
+    /// 1×68×504); default: the compiled-in one.
     #[arg(long, value_name = "MODEL.onnx")]
     pub model: Option<PathBuf>,
     /// No per-frame human-readable lines.

@@ -1,0 +1,152 @@
+#!/usr/bin/env python3
+"""Count each frame stage's instructions on the Pis' instruction sets under qemu, and project
+the stage times on a Pi 5 and a Pi 3 (docs/pi-budget.md says how and how far to trust it).
+
+    python3 bench/pi/budget.py [--frames 3,13] [--json OUT.json]
+
+Needs gcc, qemu-user (qemu-aarch64, qemu-arm) and the cross-built static binaries of the CI's
+cross stage (target/<triple>/release/umbra, features method-b). For every board it runs
+`umbra run --speed max --quiet` on the simulated robot with each stage set switched on in turn
+(none, Method A, Method B, Method B with the int8 file, both; deadlines relaxed so that no stage is ever skipped) under
+`qemu-<arch> -cpu <core> -plugin libinsn.so` (`insn.c`), at two frame counts: the difference
+divided by the frames between is one steady-state frame, start-up (model loading, tract's
+optimisation) cancelling out. A stage is its set's count less the "none" run's (the simulator,
+LiDAR decoding, pose, world model and output, reported as "base").
+
+Only the standard library: runs with any python3.
+"""
+
+import argparse
+import concurrent.futures
+import json
+import os
+import subprocess
+import sys
+import tempfile
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[2]
+
+# (board, qemu, -cpu model, target triple, clock GHz, environment). The Pi 3 on its 32-bit OS
+# runs the A53 in AArch32; qemu-arm's cortex-a15 is the ARMv7-A core with the NEON/VFPv4 that
+# tract's armv7 kernels need (qemu-arm has no AArch32 A53 model). qemu 7.2 hands the guest the
+# host's /proc/cpuinfo, where tract reads the CPU part and (armv7) NEON: the environment tells
+# tract what the real board's /proc/cpuinfo would (a Pi 5's A76, part 0xd0b, is tract's
+# "generic" kind as it is here; a Pi 3's A53, part 0xd03, its "a53" kind; armv7 NEON is there).
+# Dot-product (int8) and other features come from the emulated core's HWCAP, as on the board.
+BOARDS = [
+    ("Pi 5 (A76, 64-bit)", "qemu-aarch64", "cortex-a76", "aarch64-unknown-linux-gnu", 2.4, {}),
+    ("Pi 3 (A53, 64-bit OS)", "qemu-aarch64", "cortex-a53", "aarch64-unknown-linux-gnu", 1.2,
+     {"TRACT_CPU_AARCH64_KIND": "a53"}),
+    ("Pi 3 (A53, 32-bit OS)", "qemu-arm", "cortex-a15", "armv7-unknown-linux-gnueabihf", 1.2,
+     {"TRACT_CPU_ARM32_NEON": "true"}),
+]
+
+# Instructions per cycle assumed for each core on this code, low and high (docs/pi-budget.md).
+IPC = {"cortex-a76": (1.2, 2.4), "cortex-a53": (0.35, 0.9), "cortex-a15": (0.35, 0.9)}
+
+# Stage sets: (Method A on, Method B on, Method B's model file or None for the compiled-in fp32).
+INT8 = ROOT / "models" / "yolo" / "umbra-yolov8n-int8.onnx"
+SETS = {"none": (False, False, None), "a": (True, False, None), "b": (False, True, None),
+        "ab": (True, True, None), "b_int8": (False, True, INT8)}
+
+CONFIG = """# bench/pi/budget.py: no deadline pressure, so every stage runs every frame.
+[runtime]
+deadline_ms = 10000
+
+[runtime.budget_ms]
+ingest = 1000
+pose = 1000
+method_a = 3000
+method_b = 4000
+output = 1000
+
+[method_a]
+enabled = {a}
+
+[method_b]
+enabled = {b}
+{model}"""
+
+
+def plugin(work: Path) -> Path:
+    so = work / "libinsn.so"
+    subprocess.run(["gcc", "-shared", "-fPIC", "-O2", "-o", str(so),
+                    str(Path(__file__).with_name("insn.c"))], check=True)
+    return so
+
+
+def count(qemu: str, cpu: str, board_env: dict, so: Path, binary: Path, config: Path,
+          frames: int, out: Path) -> int:
+    out.unlink(missing_ok=True)
+    env = dict(os.environ, INSN_OUT=str(out), **board_env)
+    cmd = [qemu, "-cpu", cpu, "-plugin", str(so), str(binary), "run", "--speed", "max",
+           "--quiet", "--frames", str(frames), "--config", str(config)]
+    subprocess.run(cmd, env=env, check=True, stdout=subprocess.DEVNULL,
+                   stderr=subprocess.DEVNULL)
+    # qemu may call the plugin's exit hook more than once (a thread's exit, then the
+    # process's); the last and largest count is the whole run's.
+    return max(int(line.split()[1]) for line in out.read_text().splitlines()
+               if line.startswith("insns "))
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--frames", default="3,13", help="the two frame counts (Method B starts "
+                    "at the third frame: both must be at least 3)")
+    ap.add_argument("--jobs", type=int, default=2)
+    ap.add_argument("--json", type=Path)
+    a = ap.parse_args()
+    f0, f1 = (int(x) for x in a.frames.split(","))
+    if not 3 <= f0 < f1:
+        sys.exit("--frames: need 3 <= first < second")
+    work = Path(tempfile.mkdtemp(prefix="umbra-pi-budget-"))
+    so = plugin(work)
+    configs = {}
+    for name, (ma, mb, model) in SETS.items():
+        configs[name] = work / f"{name}.toml"
+        configs[name].write_text(CONFIG.format(a=str(ma).lower(), b=str(mb).lower(),
+                                               model=f'model = "{model}"\n' if model else ""))
+    jobs = {}
+    with concurrent.futures.ThreadPoolExecutor(a.jobs) as pool:
+        for board, qemu, cpu, triple, _, board_env in BOARDS:
+            binary = ROOT / "target" / triple / "release" / "umbra"
+            if not binary.exists():
+                sys.exit(f"{binary}: build it first (.ci/run cross)")
+            for s in SETS:
+                for n in (f0, f1):
+                    out = work / f"{cpu}-{triple}-{s}-{n}.txt"
+                    jobs[(board, s, n)] = pool.submit(count, qemu, cpu, board_env, so,
+                                                      binary, configs[s], n, out)
+    per_frame = {}
+    for board, *_ in BOARDS:
+        steady = {s: (jobs[(board, s, f1)].result() - jobs[(board, s, f0)].result()) / (f1 - f0)
+                  for s in SETS}
+        per_frame[board] = {
+            "base": steady["none"],
+            "method_a": steady["a"] - steady["none"],
+            "method_b": steady["b"] - steady["none"],
+            "both": steady["ab"] - steady["none"],
+            "method_b_int8": steady["b_int8"] - steady["none"],
+            "startup_b": jobs[(board, "b", f0)].result() - f0 * steady["b"],
+        }
+    print("| board | stage | M instructions / frame | projected ms (IPC low–high) |")
+    print("|---|---|---|---|")
+    rows = []
+    for board, _, cpu, _, ghz, _ in BOARDS:
+        lo, hi = IPC[cpu]
+        for stage in ("base", "method_a", "method_b", "method_b_int8", "both"):
+            n = per_frame[board][stage]
+            slow, fast = n / (lo * ghz * 1e6), n / (hi * ghz * 1e6)
+            rows.append(dict(board=board, stage=stage, instructions=n, ms_low_ipc=slow,
+                             ms_high_ipc=fast, ghz=ghz, ipc=[lo, hi]))
+            print(f"| {board} | {stage} | {n / 1e6:.1f} | {fast:.0f}–{slow:.0f} |")
+        print(f"| {board} | Method B start-up (once) | "
+              f"{per_frame[board]['startup_b'] / 1e6:.0f} | |")
+    if a.json:
+        a.json.write_text(json.dumps(dict(frames=[f0, f1], rows=rows, raw={
+            f"{b}|{s}|{n}": j.result() for (b, s, n), j in jobs.items()}), indent=1))
+
+
+if __name__ == "__main__":
+    main()
