@@ -209,13 +209,7 @@ where
 mod test {
     use super::*;
 
-    fn seg(ax: f32, ay: f32, bx: f32, by: f32) -> Segment {
-        Segment {
-            a: Point2::new(ax, ay),
-            b: Point2::new(bx, by),
-            support: 10,
-        }
-    }
+    use crate::walls::test_seg as seg;
 
     #[test]
     fn collinear_gap_is_a_door() {

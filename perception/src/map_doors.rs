@@ -236,15 +236,7 @@ pub fn observe(
 #[cfg(test)]
 mod test {
     use super::*;
-    use crate::walls::Segment;
-
-    fn seg(ax: f32, ay: f32, bx: f32, by: f32) -> Segment {
-        Segment {
-            a: Point2::new(ax, ay),
-            b: Point2::new(bx, by),
-            ..Segment::default()
-        }
-    }
+    use crate::walls::test_seg as seg;
 
     /// A map of the wall y = 2 with a gap from x = 0.5 to x = 1.4, seen from the origin.
     fn wall_with_gap() -> WallMap {

@@ -365,13 +365,7 @@ impl WallMap {
 mod test {
     use super::*;
 
-    fn seg(ax: f32, ay: f32, bx: f32, by: f32) -> Segment {
-        Segment {
-            a: Point2::new(ax, ay),
-            b: Point2::new(bx, by),
-            support: 30,
-        }
-    }
+    use crate::walls::test_seg as seg;
 
     const ROBOT: Point2 = Point2::new(0.0, 0.0);
 

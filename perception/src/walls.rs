@@ -381,6 +381,17 @@ pub type Segments = Vec<Segment, MAX_SEGMENTS>;
 /// Corners of a frame.
 pub type Corners = Vec<Point2, MAX_CORNERS>;
 
+/// A segment from (ax, ay) to (bx, by) with 30 points behind it: the wall piece of the tests of
+/// every module that reads segments.
+#[cfg(test)]
+pub(crate) fn test_seg(ax: f32, ay: f32, bx: f32, by: f32) -> Segment {
+    Segment {
+        a: Point2::new(ax, ay),
+        b: Point2::new(bx, by),
+        support: 30,
+    }
+}
+
 #[cfg(test)]
 mod test {
     use super::*;
