@@ -54,6 +54,9 @@ IPC = {"cortex-a76": (1.2, 2.4), "cortex-a53": (0.35, 0.9), "cortex-a15": (0.35,
 INT8 = ROOT / "models" / "yolo" / "umbra-yolov8n-int8.onnx"
 SETS = {"none": (False, False, None), "a": (True, False, None), "b": (False, True, None),
         "ab": (True, True, None), "b_int8": (False, True, INT8)}
+# The stages reported, each the steady count of a set less the "none" set's ("base": none's own).
+STAGES = {"base": "none", "method_a": "a", "method_b": "b", "method_b_int8": "b_int8",
+          "both": "ab"}
 
 CONFIG = """# bench/pi/budget.py: no deadline pressure, so every stage runs every frame.
 [runtime]
@@ -72,6 +75,11 @@ enabled = {a}
 [method_b]
 enabled = {b}
 {model}"""
+
+
+def umbra(triple: str) -> Path:
+    """The cross-built static binary for `triple`."""
+    return ROOT / "target" / triple / "release" / "umbra"
 
 
 def plugin(work: Path) -> Path:
@@ -118,7 +126,7 @@ def main() -> None:
         sys.exit("--frames: need 3 <= first < second")
     work = Path(tempfile.mkdtemp(prefix="umbra-pi-budget-"))
     so = plugin(work)
-    probe = ROOT / "target" / BOARDS[0][3] / "release" / "umbra"
+    probe = umbra(BOARDS[0][3])
     if probe.exists() and not loads_plugin(BOARDS[0][1], so, probe, work / "probe.txt"):
         # A QEMU whose plugin API no longer takes version 1 (QEMU >= 9): say so, do not fail.
         print(f"skipped: {BOARDS[0][1]} cannot load the counting plugin (insn.c is written "
@@ -132,7 +140,7 @@ def main() -> None:
     jobs = {}
     with concurrent.futures.ThreadPoolExecutor(a.jobs) as pool:
         for board, qemu, cpu, triple, _, board_env in BOARDS:
-            binary = ROOT / "target" / triple / "release" / "umbra"
+            binary = umbra(triple)
             if not binary.exists():
                 sys.exit(f"{binary}: build it first (.ci/run cross)")
             for s in SETS:
@@ -145,19 +153,16 @@ def main() -> None:
         steady = {s: (jobs[(board, s, f1)].result() - jobs[(board, s, f0)].result()) / (f1 - f0)
                   for s in SETS}
         per_frame[board] = {
-            "base": steady["none"],
-            "method_a": steady["a"] - steady["none"],
-            "method_b": steady["b"] - steady["none"],
-            "both": steady["ab"] - steady["none"],
-            "method_b_int8": steady["b_int8"] - steady["none"],
-            "startup_b": jobs[(board, "b", f0)].result() - f0 * steady["b"],
+            stage: steady[s] - (steady["none"] if s != "none" else 0.0)
+            for stage, s in STAGES.items()
         }
+        per_frame[board]["startup_b"] = jobs[(board, "b", f0)].result() - f0 * steady["b"]
     print("| board | stage | M instructions / frame | projected ms (IPC low–high) |")
     print("|---|---|---|---|")
     rows = []
     for board, _, cpu, _, ghz, _ in BOARDS:
         lo, hi = IPC[cpu]
-        for stage in ("base", "method_a", "method_b", "method_b_int8", "both"):
+        for stage in STAGES:
             n = per_frame[board][stage]
             slow, fast = n / (lo * ghz * 1e6), n / (hi * ghz * 1e6)
             rows.append(dict(board=board, stage=stage, instructions=n, ms_low_ipc=slow,

@@ -604,7 +604,7 @@ mod test {
         let mut scratch = DecodeScratch::new();
         let st = decode(&t, ANCHORS, &DecodeConfig::RUNTIME, &mut scratch, &mut out).unwrap();
         assert_eq!((st.candidates, out.len()), (2, 2));
-        let chair = 1.0 / (1.0 + libm::expf(-2.0));
+        let chair = sigmoid(2.0);
         let near = |d: &Detection, want: [f32; 5]| {
             let got = [d.score, d.cx, d.cy, d.w, d.h];
             assert!(
@@ -615,10 +615,7 @@ mod test {
         assert_eq!(out[0].class, ObjectClass::Chair);
         near(&out[0], [chair, 88.0, 30.0, 40.0, 20.0]);
         assert_eq!(out[1].class, ObjectClass::Desk);
-        near(
-            &out[1],
-            [1.0 / (1.0 + libm::expf(-1.0)), 176.0, 48.0, 64.0, 64.0],
-        );
+        near(&out[1], [sigmoid(1.0), 176.0, 48.0, 64.0, 64.0]);
         // The same boxes given in Ultralytics' form decode to the same detections.
         let boxes = tensor(&[
             (a0, [88.0, 30.0, 40.0, 20.0], [chair, 0.0, 0.0, 0.0]),
