@@ -12,7 +12,7 @@ use criterion::{Criterion, criterion_group, criterion_main};
 use perception::class::ObjectClass;
 use perception::fusion::{Evidence, FrameObject};
 use perception::geometry::{Point2, Pose2};
-use perception::tracks::{TrackConfig, Tracks};
+use perception::tracks::{Looked, TrackConfig, Tracks};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use std::hint::black_box;
@@ -103,7 +103,15 @@ fn world(c: &mut Criterion) {
     // Warm the table up on the whole sequence once, so every measured frame meets a full room.
     let mut warm = Tracks::new();
     for (k, f) in frames.iter().enumerate() {
-        warm.update(k as u64, k as f64 * 0.2, &f.obs, &f.lidar, &f.ranges, &cfg);
+        warm.update(
+            k as u64,
+            k as f64 * 0.2,
+            &f.obs,
+            &f.lidar,
+            &f.ranges,
+            Looked::BOTH,
+            &cfg,
+        );
     }
     let mut group = c.benchmark_group("world_model_frame");
     group.bench_function("umbra_tracks_update", |b| {
@@ -117,6 +125,7 @@ fn world(c: &mut Criterion) {
                 black_box(&f.obs),
                 &f.lidar,
                 &f.ranges,
+                Looked::BOTH,
                 &cfg,
             );
             k += 1;

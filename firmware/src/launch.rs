@@ -337,7 +337,9 @@ fn run_loop(
             m.x
         );
     }
-    let mut method_b = load_method_b(cfg, common)?;
+    // Frames at the LiDAR's pace: a port, or a simulation or replay in real time.
+    let live = pacing == Pacing::RealTime || !(source.is_file() || source.is_simulated());
+    let mut method_b = load_method_b(cfg, common, live)?;
     if let Some(b) = method_b.as_mut() {
         b.mount = mount;
     }
@@ -469,7 +471,11 @@ fn start_viz(
 
 /// Built without Method B: says so once and runs Method A only.
 #[cfg(not(feature = "method-b"))]
-fn load_method_b(cfg: &Config, _common: &Common) -> Result<Option<MethodBSetup>, Failure> {
+fn load_method_b(
+    cfg: &Config,
+    _common: &Common,
+    _live: bool,
+) -> Result<Option<MethodBSetup>, Failure> {
     if cfg.method_b.enabled {
         log::warn!("this umbra was built without Method B (feature method-b): Method A only");
     }
@@ -477,9 +483,14 @@ fn load_method_b(cfg: &Config, _common: &Common) -> Result<Option<MethodBSetup>,
 }
 
 /// Loads Method B's model (`--model`, else `[method_b] model`, else the compiled-in one); a
-/// bad file is a start-up error naming it (exit 2).
+/// bad file is a start-up error naming it (exit 2). `live`: frames come at the LiDAR's pace
+/// (the schedule's `auto` needs it).
 #[cfg(feature = "method-b")]
-fn load_method_b(cfg: &Config, common: &Common) -> Result<Option<MethodBSetup>, Failure> {
+fn load_method_b(
+    cfg: &Config,
+    common: &Common,
+    live: bool,
+) -> Result<Option<MethodBSetup>, Failure> {
     if !cfg.method_b.enabled {
         if common.model.is_some() {
             log::warn!("--model given but [method_b] enabled = false: Method B stays off");
@@ -491,12 +502,26 @@ fn load_method_b(cfg: &Config, common: &Common) -> Result<Option<MethodBSetup>, 
     };
     let path = common.model.as_deref().or(cfg.method_b.model.as_deref());
     let model = YoloModel::load_or_builtin(path, opts).map_err(|e| (EXIT_USAGE, e.to_string()))?;
-    log::info!("Method B: {}", model.name());
+    let board = crate::power::Board::this(cfg.power.board);
+    let schedule = cfg
+        .method_b
+        .schedule
+        .resolve(board.unwrap_or(crate::power::Board::Pi5), live);
+    log::info!(
+        "Method B: {}, {}",
+        model.name(),
+        match schedule {
+            runner::Schedule::Worker => "on its own thread (frames do not wait for it)",
+            _ => "in the frame",
+        }
+    );
     Ok(Some(MethodBSetup {
         model: Box::new(model),
         raster: cfg.method_b_raster(),
         decode: cfg.method_b_decode(),
         mount: cfg.lidar_mount(),
+        schedule,
+        every: cfg.method_b.every,
     }))
 }
 
@@ -533,6 +558,12 @@ fn print_summary(s: &Summary) {
         eprintln!(
             "umbra: recording/live view dropped {} frames (its thread was behind)",
             s.viz_dropped
+        );
+    }
+    if s.method_b_worker {
+        eprintln!(
+            "umbra: Method B on its own thread: {} runs in {} frames",
+            s.method_b_runs, s.frames
         );
     }
     eprint!("{}", s.table());

@@ -88,6 +88,17 @@ impl Board {
         }
     }
 
+    /// The board this runs on: the configured one, else the one the device tree names
+    /// (`None`: not a Pi we know).
+    pub fn this(cfg: Board) -> Option<Board> {
+        match cfg {
+            Board::Auto => device_tree_model()
+                .as_deref()
+                .and_then(Board::from_device_tree),
+            b => Some(b),
+        }
+    }
+
     /// The board named by a device-tree model string (`None`: not a Pi we know).
     pub fn from_device_tree(model: &str) -> Option<Board> {
         let m = model.trim_end_matches('\0');

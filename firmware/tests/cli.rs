@@ -702,6 +702,65 @@ fn over_budget_frames_shed_method_b_first_and_are_counted() {
 }
 
 #[test]
+fn method_b_follows_its_schedule() {
+    // `every = 3`: Method B in frames 3, 6, 9 (frames 0–1 fill its three revolutions), none
+    // skipped by the policy.
+    let cfg = tmp("every.toml");
+    std::fs::write(&cfg, "[method_b]\nevery = 3\n").unwrap();
+    let jsonl = tmp("every.jsonl");
+    let args = |cfg: &Path, speed: &'static str, jsonl: &Path| -> Vec<String> {
+        [
+            "run", "--frames", "11", "--speed", speed, "--quiet", "--config",
+        ]
+        .iter()
+        .map(|s| s.to_string())
+        .chain([
+            cfg.display().to_string(),
+            "--jsonl".into(),
+            jsonl.display().to_string(),
+        ])
+        .collect()
+    };
+    let run = |a: Vec<String>| umbra(&a.iter().map(String::as_str).collect::<Vec<_>>());
+    let out = run(args(&cfg, "max", &jsonl));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let lines = json_lines(&jsonl);
+    let with_b: Vec<u64> = lines
+        .iter()
+        .filter(|l| l["timing_ms"].get("method_b").is_some_and(|v| !v.is_null()))
+        .map(|l| l["frame"].as_u64().unwrap())
+        .collect();
+    assert_eq!(with_b, [3, 6, 9]);
+    assert_eq!(lines.last().unwrap()["faults"]["method_b_skipped"], 0);
+    // A Pi 3 puts Method B on its own thread at the LiDAR's pace, and keeps it in the frame
+    // at full speed (a deterministic replay).
+    std::fs::write(&cfg, "[power]\nboard = \"pi3b\"\n").unwrap();
+    for (speed, worker) in [("max", false), ("1", true)] {
+        let out = Command::new(env!("CARGO_BIN_EXE_umbra"))
+            .args(args(&cfg, speed, &jsonl))
+            .env("RUST_LOG", "info")
+            .output()
+            .unwrap();
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert!(out.status.success(), "{stderr}");
+        assert_eq!(
+            stderr.contains("Method B on its own thread:"),
+            worker,
+            "{speed}: {stderr}"
+        );
+        assert_eq!(
+            stderr.contains("in the frame"),
+            !worker,
+            "{speed}: {stderr}"
+        );
+    }
+}
+
+#[test]
 fn bad_budgets_and_power_settings_name_the_field() {
     for (toml, field) in [
         (

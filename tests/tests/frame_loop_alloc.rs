@@ -10,7 +10,7 @@ use std::sync::atomic::AtomicBool;
 use firmware::config::Config;
 use firmware::odom::{PoseInput, PoseState};
 use firmware::power::PowerMeter;
-use firmware::runner::{self, MethodBSetup, RunOptions, SecondsClock};
+use firmware::runner::{self, MethodBSetup, RunOptions, Schedule, SecondsClock, Summary};
 use firmware::sink::{FrameSink, JsonlSink, SceneSink, StatsSink};
 use firmware::source::{LidarSource, Pacing};
 use firmware::viz::{VizLink, VizSink};
@@ -40,10 +40,10 @@ const FRAMES: u64 = 40;
 const WARM_UP: usize = 5;
 
 fn per_frame(method_b: bool) -> Vec<u64> {
-    per_frame_with(method_b, None)
+    per_frame_with(method_b.then_some(Schedule::Inline), None).0
 }
 
-fn per_frame_with(method_b: bool, viz: Option<VizLink>) -> Vec<u64> {
+fn per_frame_with(method_b: Option<Schedule>, viz: Option<VizLink>) -> (Vec<u64>, Summary) {
     let cfg = Config::default();
     let source = LidarSource::sim(3, 3);
     let cal = source.sim_calibration();
@@ -54,18 +54,20 @@ fn per_frame_with(method_b: bool, viz: Option<VizLink>) -> Vec<u64> {
 fn per_frame_from(
     mut source: LidarSource,
     pose: PoseInput,
-    method_b: bool,
+    method_b: Option<Schedule>,
     viz: Option<VizLink>,
-) -> Vec<u64> {
+) -> (Vec<u64>, Summary) {
     let cfg = Config::default();
     let marks = Arc::new(std::sync::Mutex::new(Vec::with_capacity(
         FRAMES as usize + 8,
     )));
-    let b = method_b.then(|| MethodBSetup {
+    let b = method_b.map(|schedule| MethodBSetup {
         model: Box::new(models::yolo::YoloModel::builtin(Default::default()).expect("model")),
         raster: cfg.method_b_raster(),
         decode: cfg.method_b_decode(),
         mount: cfg.lidar_mount(),
+        schedule,
+        every: 1,
     });
     let mut sinks: Vec<Box<dyn FrameSink>> = vec![
         Box::new(JsonlSink(Box::new(Marks(marks.clone())))),
@@ -97,7 +99,7 @@ fn per_frame_from(
     assert_eq!(summary.frames, FRAMES);
     let m = marks.lock().unwrap().clone();
     assert_eq!(m.len() as u64, FRAMES);
-    m.windows(2).map(|w| w[1] - w[0]).collect()
+    (m.windows(2).map(|w| w[1] - w[0]).collect(), summary)
 }
 
 #[test]
@@ -123,6 +125,26 @@ fn with_method_b_only_tract_allocates_and_a_constant_amount() {
 }
 
 #[test]
+fn with_method_b_on_its_own_thread_the_loop_allocates_nothing() {
+    // A Pi 3's schedule: tract allocates on the worker's thread, the loop hands it one
+    // pooled job buffer through one-slot channels.
+    let (d, summary) = per_frame_with(Some(Schedule::Worker), None);
+    println!(
+        "allocations per frame, Method A + Method B on its thread ({} runs): {d:?}",
+        summary.method_b_runs
+    );
+    assert!(
+        d[WARM_UP..].iter().all(|&n| n == 0),
+        "frames after warm-up allocated: {d:?}"
+    );
+    assert!(summary.method_b_worker);
+    // However the threads interleave, the first three revolutions were handed over and the
+    // run's end waits for what is in flight.
+    assert!(summary.method_b_runs >= 1, "Method B ran on its thread");
+    assert_eq!(summary.deadlines.method_b_skipped, 0);
+}
+
+#[test]
 fn recording_costs_the_loop_no_allocation() {
     // The viz thread converts and writes (and allocates) on its own; the loop only fills
     // pooled frames (results, the raw LiDAR bytes and the odometry samples for replay).
@@ -133,7 +155,7 @@ fn recording_costs_the_loop_no_allocation() {
         meta: Default::default(),
     })
     .expect("recorder");
-    let d = per_frame_with(false, Some(link));
+    let d = per_frame_with(None, Some(link)).0;
     println!("allocations per frame, Method A, recording: {d:?}");
     assert!(
         d[WARM_UP..].iter().all(|&n| n == 0),
@@ -191,7 +213,7 @@ fn serial_source_with_reader_threads_allocates_nothing_after_warm_up() {
     let mut pose = PoseInput::new(PoseState::new(cfg.pose_filter(None), false));
     let compass: firmware::reader::CompassReader = Box::new(|| Ok([21.5, -3.2, 40.1]));
     pose.devices = Some(firmware::reader::DeviceReader::start(None, Some(compass)).unwrap());
-    let d = per_frame_from(source, pose, false, None);
+    let d = per_frame_from(source, pose, None, None).0;
     stop.store(true, std::sync::atomic::Ordering::Relaxed);
     player.join().unwrap();
     println!("allocations per frame, serial LDS-01 + device thread, Method A: {d:?}");

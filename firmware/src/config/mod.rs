@@ -70,6 +70,9 @@
 //! agnostic_nms = true          # one report per object whatever the classes
 //! max_range_m = 4.0            # range of the raster's last row: must match the training data
 //! threads = 1                  # tract worker threads
+//! schedule = "auto"            # "inline" (in the frame), "worker" (its own thread); auto:
+//!                              # worker on a Pi 3 when live, else inline (docs/pi-budget.md)
+//! every = 1                    # in the frame: Method B in one frame of this many
 //! ```
 
 use std::fmt;
@@ -368,6 +371,10 @@ pub struct MethodBSettings {
     pub max_range_m: f32,
     /// tract worker threads.
     pub threads: usize,
+    /// In the frame or on its own thread.
+    pub schedule: crate::runner::Schedule,
+    /// In the frame: Method B in one frame of this many (1: every frame).
+    pub every: u32,
 }
 
 impl Default for MethodBSettings {
@@ -381,6 +388,8 @@ impl Default for MethodBSettings {
             agnostic_nms: d.agnostic,
             max_range_m: perception::raster::RasterConfig::default().max_range_m,
             threads: 1,
+            schedule: crate::runner::Schedule::Auto,
+            every: 1,
         }
     }
 }
@@ -511,6 +520,12 @@ impl Config {
         within_b("conf", b.conf, 0.0, 1.0)?;
         within_b("iou", b.iou, 0.0, 1.0)?;
         within_b("max_range_m", b.max_range_m, 0.5, 65.0)?;
+        if !(1..=10).contains(&b.every) {
+            return Err(format!(
+                "method_b.every = {}: must be within 1..=10",
+                b.every
+            ));
+        }
         if !(1..=64).contains(&b.threads) {
             return Err(format!(
                 "method_b.threads = {}: must be within 1..=64",

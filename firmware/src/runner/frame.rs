@@ -14,11 +14,12 @@ use perception::map_doors::{Doorways, MapDoorConfig};
 use perception::method_a::{MethodA, MethodAConfig};
 use perception::outline::drop_round_boxes;
 use perception::plausible::{drop_in_map_walls, drop_walled};
-use perception::tracks::Tracks;
+use perception::tracks::{Looked, Tracks};
 use perception::wall_map::WallMap;
 use perception::wall_piece::drop_wall_pieces;
 
 use super::FrameLoop;
+use super::b_worker::BWorker;
 use super::history::ScanHistory;
 use super::method_b::MethodBScratch;
 use crate::deadline::{DeadlineRecord, FrameTimes, Policy, SHRINK_DROP_FRACTION};
@@ -51,7 +52,11 @@ pub(super) struct FrameState {
     fused: Box<FrameObjects>,
     /// The world model: objects over frames, with stable ids.
     tracks: Box<Tracks>,
+    /// Method B on its own thread (`Schedule::Worker`).
+    pub(super) worker: Option<BWorker>,
     method_b_errors: u64,
+    /// Method B runs finished (inline or on the worker).
+    pub(super) method_b_runs: u64,
     /// Host time spent in frames (taken off the link clock).
     pub(super) busy: Duration,
     /// The overrun policy's memory.
@@ -101,7 +106,9 @@ impl FrameState {
             b_scratch: MethodBScratch::default(),
             fused: Box::default(),
             tracks: Box::default(),
+            worker: None,
             method_b_errors: 0,
+            method_b_runs: 0,
             busy: Duration::ZERO,
             policy: Policy::default(),
             record: DeadlineRecord::default(),
@@ -223,6 +230,39 @@ impl FrameState {
             }
             self.method_b_errors += 1;
         }
+        self.method_b_runs += 1;
+    }
+
+    /// Method B on its worker: the boxes of a finished run join this frame's objects (their
+    /// time is returned), and the worker, when idle, gets the last three revolutions.
+    fn method_b_worker(&mut self) -> Option<f64> {
+        let worker = self.worker.as_mut()?;
+        let mut ms = None;
+        let (fused, errors) = (&mut self.fused, &mut self.method_b_errors);
+        if worker.poll(|job| {
+            for placed in &job.boxes {
+                merge_b(fused, placed);
+            }
+            *errors += u64::from(job.failed);
+            ms = Some(job.ms);
+        }) {
+            self.method_b_runs += 1;
+        }
+        if let Some((scans, middle)) = self.history.three() {
+            worker.offer(scans, middle);
+        }
+        ms
+    }
+
+    /// The end of a run: waits for a run still on the worker (counted; its boxes come too
+    /// late for any frame).
+    pub(super) fn drain_worker(&mut self) {
+        let errors = &mut self.method_b_errors;
+        if let Some(w) = self.worker.as_mut()
+            && w.wait(|job| *errors += u64::from(job.failed))
+        {
+            self.method_b_runs += 1;
+        }
     }
 }
 
@@ -235,10 +275,12 @@ impl<S: RevolutionStream> FrameLoop<'_, S> {
             stream,
             opts,
             st,
+            mount,
             summary,
             ingest,
             start,
         } = self;
+        let mount = *mount;
         let Some(rev) = stream.last_revolution() else {
             return Ok(false);
         };
@@ -292,9 +334,15 @@ impl<S: RevolutionStream> FrameLoop<'_, S> {
         let backlog_bytes = source.backlog_bytes();
         let behind = behind_lidar(source, backlog_bytes, opts.pacing, stream, start, period);
         let elapsed_ms = ingest.as_secs_f64() * 1e3 + t_frame.elapsed().as_secs_f64() * 1e3;
-        let run_b = opts.method_b.is_some() && st.history.revolutions() >= 3;
+        let run_b = opts
+            .method_b
+            .as_ref()
+            .is_some_and(|b| frame.is_multiple_of(u64::from(b.every.max(1))))
+            && st.history.revolutions() >= 3;
         let skip_b = run_b && st.policy.before_method_b(&opts.budgets, elapsed_ms, behind);
         let method_b_ms = match opts.method_b.as_mut() {
+            // On its own thread: never in the frame's way, so never skipped.
+            None if st.worker.is_some() => st.method_b_worker(),
             Some(b) if run_b && !skip_b => {
                 let t_b = Instant::now();
                 st.method_b(b);
@@ -308,11 +356,6 @@ impl<S: RevolutionStream> FrameLoop<'_, S> {
         // The world model, when on: this frame's detections update the tracks, seen from the
         // LiDAR's pose at the middle of the revolution; the confirmed tracks are the line's
         // objects. Off, the objects are the frame's detections.
-        let mount = match (&opts.method_a, &opts.method_b) {
-            (Some((_, m)), _) => *m,
-            (None, Some(b)) => b.mount,
-            (None, None) => Pose2::IDENTITY,
-        };
         // Furniture in or behind a wall this revolution showed, or in the band of a wall the
         // map holds (one this revolution may show broken), is not furniture.
         if let Some((_, m)) = &opts.method_a {
@@ -349,8 +392,20 @@ impl<S: RevolutionStream> FrameLoop<'_, S> {
         st.objects.clear();
         if let Some(cfg) = opts.world.as_ref() {
             let mid_s = t + period * 0.5;
-            st.tracks
-                .update(frame, mid_s, &st.fused, &lidar, st.history.newest(), cfg);
+            // The methods that looked: a track is not missed by a method that did not run.
+            let looked = Looked {
+                a: method_a_ms.is_some(),
+                b: method_b_ms.is_some(),
+            };
+            st.tracks.update(
+                frame,
+                mid_s,
+                &st.fused,
+                &lidar,
+                st.history.newest(),
+                looked,
+                cfg,
+            );
             // Door frames in a doorway of the map's walls are openings in a wall.
             st.tracks.anchor_doors(&doorways);
             st.people.clear();

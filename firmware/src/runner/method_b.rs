@@ -35,16 +35,55 @@ impl Network for models::yolo::YoloModel {
     }
 }
 
+/// Where Method B runs (`[method_b] schedule`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Schedule {
+    /// By the board (`docs/pi-budget.md`): on a Pi 3, live, its own thread; else inline.
+    /// The frame loop reads an unresolved `Auto` as `Inline`.
+    #[default]
+    Auto,
+    /// In the frame, after Method A, every frame the overrun policy allows.
+    Inline,
+    /// On a thread of its own (`b_worker.rs`): frames never wait for it; its boxes join the
+    /// frame in which they arrive.
+    Worker,
+}
+
+impl Schedule {
+    /// `Auto` made concrete: its own thread on a board whose one core does not run the network
+    /// inside a frame with margin (a Pi 3, projected 114–505 ms against 250), when frames come
+    /// at the LiDAR's pace (`live`: a port, or a simulation or replay in real time); inline
+    /// otherwise, so that a replay at full speed stays deterministic and a Pi 5 (17–34 ms)
+    /// keeps Method B in every frame.
+    pub fn resolve(self, board: crate::power::Board, live: bool) -> Schedule {
+        use crate::power::Board;
+        match self {
+            Schedule::Auto => match board {
+                Board::Pi3b | Board::Pi3bPlus if live => Schedule::Worker,
+                _ => Schedule::Inline,
+            },
+            s => s,
+        }
+    }
+}
+
 /// Method B at run time: the loaded model and how to read its boxes.
 pub struct MethodBSetup {
     /// The network, loaded and optimised at start-up.
-    pub model: Box<dyn Network>,
+    pub model: Box<dyn Network + Send>,
     /// Raster settings (must match the training data's).
     pub raster: RasterConfig,
     /// Thresholds and suppression.
     pub decode: DecodeConfig,
     /// The LiDAR's pose on the robot.
     pub mount: Pose2,
+    /// Inline or on its own thread (resolved; `Auto` runs inline).
+    pub schedule: Schedule,
+    /// Inline: Method B in one frame of this many (frame numbers divisible by it); 1: every
+    /// frame. A saving of power and CPU, not of any frame's time (the frames it runs in take
+    /// as long as before).
+    pub every: u32,
 }
 
 /// Method B's working memory, allocated once.

@@ -7,6 +7,7 @@
 //! | `frame.rs`    | one frame through the pipeline, and its stage times                    |
 //! | `history.rs`  | the last three revolutions and their poses                             |
 //! | `method_b.rs` | Method B as a stage, over the [`Network`] trait                        |
+//! | `b_worker.rs` | Method B on a thread of its own (a Pi 3's schedule)                    |
 //! | `summary.rs`  | what a run did                                                         |
 //!
 //! `timing_ms.ingest` is the time spent decoding the frame's bytes (not waiting for them).
@@ -16,6 +17,7 @@
 //! line's pose) and at its last, so Method A de-skews the scan. Method B reads the last three
 //! revolutions; its boxes join Method A's objects in `perception::fusion`.
 
+mod b_worker;
 mod frame;
 mod history;
 mod method_b;
@@ -31,7 +33,7 @@ use perception::method_a::MethodAConfig;
 use perception::tracks::TrackConfig;
 
 pub use history::{METHOD_B_HISTORY, ScanHistory};
-pub use method_b::{MethodBSetup, Network};
+pub use method_b::{MethodBSetup, Network, Schedule};
 pub use summary::Summary;
 
 use crate::deadline::{Budgets, PowerVerdict};
@@ -93,10 +95,24 @@ pub fn run<S: RevolutionStream>(
 ) -> Result<Summary, io::Error> {
     let start = Instant::now();
     let records = opts.sinks.iter().any(|s| s.records_input());
+    let mut opts = opts;
+    let mut st = FrameState::new(records);
+    // The LiDAR's pose on the robot, from whichever method has it.
+    let mount = match (&opts.method_a, &opts.method_b) {
+        (Some((_, m)), _) => *m,
+        (None, Some(b)) => b.mount,
+        (None, None) => Pose2::IDENTITY,
+    };
+    if opts.method_b.as_ref().map(|b| b.schedule) == Some(Schedule::Worker)
+        && let Some(b) = opts.method_b.take()
+    {
+        st.worker = Some(b_worker::BWorker::start(b)?);
+    }
     let mut lp = FrameLoop {
         source,
         stream,
-        st: FrameState::new(records),
+        st,
+        mount,
         opts,
         summary: Summary::default(),
         ingest: Duration::ZERO,
@@ -115,6 +131,8 @@ struct FrameLoop<'s, S> {
     stream: S,
     opts: RunOptions,
     st: FrameState,
+    /// The LiDAR's pose on the robot.
+    mount: Pose2,
     summary: Summary,
     /// Time spent decoding since the last frame.
     ingest: Duration,
@@ -223,7 +241,10 @@ impl<S: RevolutionStream> FrameLoop<'_, S> {
 
     /// Closes the run: the sinks finish (flush, close, draw), the summary is filled in.
     fn end(mut self, reason: &'static str) -> io::Result<Summary> {
+        self.st.drain_worker();
         let s = &mut self.summary;
+        s.method_b_runs = self.st.method_b_runs;
+        s.method_b_worker = self.st.worker.is_some();
         s.faults = self.stream.faults();
         s.link = self.source.link_counts();
         s.sensor_seconds = self.stream.sensor_time_s();

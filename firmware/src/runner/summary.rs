@@ -35,6 +35,10 @@ pub struct Summary {
     pub viz_dropped: u64,
     /// Detections dropped for lying in or behind a wall (`perception::plausible`).
     pub walled_detections: u64,
+    /// Method B runs finished.
+    pub method_b_runs: u64,
+    /// Method B ran on its own thread (`[method_b] schedule`).
+    pub method_b_worker: bool,
 }
 
 impl Summary {

@@ -13,7 +13,8 @@
 //!    method saw it.
 //! 3. **Negative evidence** for every unmatched track in range: when the revolution's rays
 //!    across the track's footprint all returned from beyond it, the place was seen empty and
-//!    existence falls by `free_loss`; in plain view and not observed, by `miss_loss`. Rays
+//!    existence falls by `free_loss`; in plain view and not observed, by `miss_loss` (only in
+//!    a frame in which a method that has seen it looked: [`Looked`], `negative.rs`). Rays
 //!    that end before it (something in front) say nothing. A door frame the map's walls showed
 //!    as a doorway ([`Tracks::anchor_doors`]) is an opening: rays through it are what it looks
 //!    like; it loses belief when its middle is seen closed, or when the rays pass its jambs'
@@ -38,7 +39,11 @@ use crate::class::ObjectClass;
 use crate::fusion::{Evidence, FrameObject};
 use crate::geometry::{Point2, Pose2};
 use crate::motion::{Motion, MotionConfig};
-use crate::sight::{BINS, DoorView, View, doorway_view, view};
+use crate::sight::BINS;
+
+mod negative;
+
+pub use negative::Looked;
 
 /// Tracks held at most.
 pub const MAX_TRACKS: usize = 64;
@@ -305,7 +310,8 @@ impl Tracks {
 
     /// One frame: `obs` are the frame's objects (map frame), `stamp_s` the revolution's time
     /// (s, any origin; it times the motion filter), `lidar` the LiDAR's pose in the map at the
-    /// revolution, `ranges` its 360 bins (0 = no return).
+    /// revolution, `ranges` its 360 bins (0 = no return), `looked` the methods that ran
+    /// (a track is missed only in a frame in which a method that has seen it looked).
     #[allow(clippy::too_many_arguments)]
     pub fn update(
         &mut self,
@@ -314,6 +320,7 @@ impl Tracks {
         obs: &[FrameObject],
         lidar: &Pose2,
         ranges: &[f32; BINS],
+        looked: Looked,
         cfg: &TrackConfig,
     ) {
         let pose_ok = lidar.x.is_finite() && lidar.y.is_finite() && lidar.theta.is_finite();
@@ -381,38 +388,8 @@ impl Tracks {
         // Negative evidence for the unmatched tracks in view.
         if pose_ok {
             for (i, t) in self.tracks.iter_mut().enumerate() {
-                if matched[i] {
-                    continue;
-                }
-                let (loss, in_view) = if t.class() == ObjectClass::DoorFrame && t.anchored {
-                    // An opening in a wall: seen through is what it looks like.
-                    let jambs = if t.width_m > 0.0 {
-                        0.5 * t.width_m
-                    } else {
-                        t.radius()
-                    };
-                    match doorway_view(t.centre, jambs, lidar, ranges, cfg.max_range_m) {
-                        DoorView::Closed => (cfg.miss_loss, true),
-                        DoorView::NoJambs => (cfg.free_loss, true),
-                        // In view all the same: a one-method door must be seen at its rate.
-                        DoorView::Open => (0.0, true),
-                        DoorView::Hidden => (0.0, false),
-                    }
-                } else {
-                    let loss = match view(t.centre, t.radius(), lidar, ranges, cfg.max_range_m) {
-                        View::Empty => cfg.free_loss,
-                        View::Plain => cfg.miss_loss,
-                        View::Hidden => 0.0,
-                    };
-                    (loss, loss > 0.0)
-                };
-                if in_view {
-                    t.views = t.views.saturating_add(1);
-                }
-                t.existence = (t.existence - loss).max(-cfg.existence_cap);
-                if t.existence < cfg.confirm_existence {
-                    // Reported again only once the evidence is back.
-                    t.confirmed = false;
+                if !matched[i] {
+                    negative::unobserved(t, lidar, ranges, looked, cfg);
                 }
             }
         }
@@ -631,7 +608,7 @@ mod test {
         ranges: &[f32; BINS],
         cfg: &TrackConfig,
     ) {
-        t.update(f, f as f64 * 0.2, obs, lidar, ranges, cfg);
+        t.update(f, f as f64 * 0.2, obs, lidar, ranges, Looked::BOTH, cfg);
     }
 
     /// A revolution from the origin facing +x with every ray returning at `r` m.
@@ -1077,6 +1054,54 @@ mod test {
             step(&mut t, f, seen, &Pose2::IDENTITY, &on_it, &cfg);
             assert_eq!(t.confirmed().count(), 0, "frame {f}");
         }
+    }
+
+    #[test]
+    fn a_method_that_did_not_run_misses_nothing() {
+        // Method B on its own thread (a Pi 3): it reports in every other frame. A chair only it
+        // sees is in plain view throughout; the frames without Method B are not misses and do
+        // not count against its rate, so it is reported as if Method B ran every frame.
+        let cfg = TrackConfig::default();
+        let on_it = ranges(2.0);
+        let mut t = Tracks::new();
+        for f in 0..20u64 {
+            let o = [obs(CHAIR, 2.0, 0.0, 0.9, Evidence::B)];
+            let ran = f % 2 == 0;
+            let seen: &[FrameObject] = if ran { &o } else { &[] };
+            let looked = Looked { a: true, b: ran };
+            t.update(
+                f,
+                f as f64 * 0.2,
+                seen,
+                &Pose2::IDENTITY,
+                &on_it,
+                looked,
+                &cfg,
+            );
+        }
+        let chair = t.all()[0];
+        assert!(chair.confirmed, "{chair:?}");
+        assert_eq!((chair.hits, chair.views), (10, 10));
+        // What the rays show needs no method: its place seen empty, it goes, Method B or not.
+        let through = ranges(3.0);
+        let mut gone = None;
+        for f in 20..40u64 {
+            let looked = Looked { a: true, b: false };
+            t.update(
+                f,
+                f as f64 * 0.2,
+                &[],
+                &Pose2::IDENTITY,
+                &through,
+                looked,
+                &cfg,
+            );
+            if t.all().is_empty() {
+                gone = Some(f);
+                break;
+            }
+        }
+        assert!(gone.is_some_and(|f| f < 30), "deleted at {gone:?}");
     }
 
     #[test]

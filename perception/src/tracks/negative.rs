@@ -1,0 +1,77 @@
+//! What a frame says about a track it did not observe: negative evidence, and whether the
+//! frame counts as one in which the track was in view.
+//!
+//! Two kinds of evidence, kept apart because they do not depend on the same thing:
+//! * **what the rays show** — the track's footprint seen empty (every ray across it returned
+//!   from beyond), or an anchored doorway seen shut or without its jambs — is evidence in any
+//!   frame, whichever method ran;
+//! * **a miss** — in plain view and not detected — is evidence only when a method that has
+//!   seen the track looked in this frame. A track only Method B has seen is not missed in a
+//!   frame Method B did not run in (skipped by the overrun policy, or on its own thread and
+//!   not finished: a Pi 3's schedule), and that frame does not count against its detection
+//!   rate either.
+
+use super::{Track, TrackConfig};
+use crate::class::ObjectClass;
+use crate::geometry::Pose2;
+use crate::sight::{BINS, DoorView, View, doorway_view, view};
+
+/// Which methods looked in a frame (ran, and their detections are among the frame's).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct Looked {
+    /// Method A.
+    pub a: bool,
+    /// Method B.
+    pub b: bool,
+}
+
+impl Looked {
+    /// Both methods looked.
+    pub const BOTH: Looked = Looked { a: true, b: true };
+
+    /// Whether a method that has seen `t` looked.
+    fn for_track(self, t: &Track) -> bool {
+        (self.a && t.seen_a) || (self.b && t.seen_b)
+    }
+}
+
+/// Applies this frame's negative evidence to `t`, which took no observation.
+pub(super) fn unobserved(
+    t: &mut Track,
+    lidar: &Pose2,
+    ranges: &[f32; BINS],
+    looked: Looked,
+    cfg: &TrackConfig,
+) {
+    let looked_for = looked.for_track(t);
+    let (loss, in_view) = if t.class() == ObjectClass::DoorFrame && t.anchored {
+        // An opening in a wall: seen through is what it looks like.
+        let jambs = if t.width_m > 0.0 {
+            0.5 * t.width_m
+        } else {
+            t.radius()
+        };
+        match doorway_view(t.centre, jambs, lidar, ranges, cfg.max_range_m) {
+            DoorView::Closed => (cfg.miss_loss, true),
+            DoorView::NoJambs => (cfg.free_loss, true),
+            // In view all the same: a one-method door must be seen at its rate.
+            DoorView::Open => (0.0, looked_for),
+            DoorView::Hidden => (0.0, false),
+        }
+    } else {
+        match view(t.centre, t.radius(), lidar, ranges, cfg.max_range_m) {
+            View::Empty => (cfg.free_loss, true),
+            View::Plain if looked_for => (cfg.miss_loss, true),
+            View::Plain | View::Hidden => (0.0, false),
+        }
+    };
+    if in_view {
+        t.views = t.views.saturating_add(1);
+    }
+    t.existence = (t.existence - loss).max(-cfg.existence_cap);
+    if t.existence < cfg.confirm_existence {
+        // Reported again only once the evidence is back.
+        t.confirmed = false;
+    }
+}
