@@ -127,6 +127,15 @@ impl Pose2 {
         Pose2::new(p.x, p.y, self.theta + other.theta)
     }
 
+    /// The pose halfway to `other` (heading along the shorter way round).
+    pub fn midway(&self, other: &Pose2) -> Pose2 {
+        Pose2::new(
+            (self.x + other.x) / 2.0,
+            (self.y + other.y) / 2.0,
+            wrap_angle(self.theta + wrap_angle(other.theta - self.theta) / 2.0),
+        )
+    }
+
     /// The inverse transform.
     pub fn inverse(&self) -> Pose2 {
         let (s, c) = (libm::sinf(self.theta), libm::cosf(self.theta));
@@ -146,6 +155,15 @@ mod test {
 
     fn close(a: f32, b: f32) -> bool {
         (a - b).abs() < 1e-4
+    }
+
+    #[test]
+    fn midway_turns_the_shorter_way_round() {
+        let m = Pose2::new(0.0, 0.0, 3.0).midway(&Pose2::new(2.0, 4.0, -3.0));
+        assert!(close(m.x, 1.0) && close(m.y, 2.0), "{m:?}");
+        assert!(close(m.theta.abs(), PI), "across ±π, not through 0: {m:?}");
+        let m = Pose2::new(0.0, 0.0, -0.5).midway(&Pose2::new(0.0, 0.0, 1.5));
+        assert!(close(m.theta, 0.5), "{m:?}");
     }
 
     #[test]

@@ -29,7 +29,6 @@ use crate::output::{
 };
 use crate::record_format::RECORD_RAW_BYTES;
 use crate::sink::FrameView;
-use crate::source::{LidarSource, Pacing};
 use drivers::lidar::RevolutionStream;
 
 /// A Method B door frame this close to a door of Method A's is that door, m.
@@ -327,12 +326,12 @@ impl<S: RevolutionStream> FrameLoop<'_, S> {
             st.policy.method_a_took(ms);
             ms
         });
-        st.history.commit(midway(&pose.start, &pose.end));
+        st.history.commit(pose.start.midway(&pose.end));
 
         // Method B, unless the overrun policy sheds it (no room left, or decimated while
         // behind the LiDAR).
         let backlog_bytes = source.backlog_bytes();
-        let behind = behind_lidar(source, backlog_bytes, opts.pacing, stream, start, period);
+        let behind = super::behind_lidar(source, backlog_bytes, opts.pacing, stream, start, period);
         let elapsed_ms = ingest.as_secs_f64() * 1e3 + t_frame.elapsed().as_secs_f64() * 1e3;
         let run_b = opts
             .method_b
@@ -366,7 +365,7 @@ impl<S: RevolutionStream> FrameLoop<'_, S> {
             st.walled += u64::from(drop_in_map_walls(&mut st.fused, &st.wall_map));
         }
         // Nor is a detection whose returns lie on a line that goes on as a wall does.
-        let lidar = midway(&pose.start, &pose.end).compose(&mount);
+        let lidar = pose.start.midway(&pose.end).compose(&mount);
         // Doorways in the map's walls that this revolution sees through are door frames too
         // (a door beside a short piece of wall, or in a wall one scan shows broken).
         let doorways = if opts.method_a.is_some() {
@@ -568,35 +567,4 @@ impl<S: RevolutionStream> FrameLoop<'_, S> {
         st.busy += t_frame.elapsed();
         Ok(opts.frames.is_some_and(|n| summary.frames >= n))
     }
-}
-
-/// Whether the loop has fallen more than a revolution behind the LiDAR: bytes queued on a
-/// port, or (simulated robot paced in real time) wall time ahead of the sensor clock.
-fn behind_lidar(
-    source: &LidarSource,
-    backlog_bytes: Option<u32>,
-    pacing: Pacing,
-    stream: &impl RevolutionStream,
-    start: &Instant,
-    period_s: f64,
-) -> bool {
-    if let Some(queued) = backlog_bytes {
-        return stream
-            .bytes_per_revolution()
-            .is_some_and(|per_rev| queued > per_rev);
-    }
-    source.is_simulated()
-        && pacing == Pacing::RealTime
-        && start.elapsed().as_secs_f64() - stream.sensor_time_s() > period_s
-}
-
-/// The pose halfway between two poses (heading along the shorter way round).
-fn midway(a: &Pose2, b: &Pose2) -> Pose2 {
-    Pose2::new(
-        (a.x + b.x) / 2.0,
-        (a.y + b.y) / 2.0,
-        perception::geometry::wrap_angle(
-            a.theta + perception::geometry::wrap_angle(b.theta - a.theta) / 2.0,
-        ),
-    )
 }

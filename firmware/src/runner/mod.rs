@@ -285,3 +285,23 @@ impl<S: RevolutionStream> FrameLoop<'_, S> {
         result.map(|()| self.summary)
     }
 }
+
+/// Whether the loop has fallen more than a revolution behind the LiDAR: bytes queued on a
+/// port, or (simulated robot paced in real time) wall time ahead of the sensor clock.
+fn behind_lidar(
+    source: &LidarSource,
+    backlog_bytes: Option<u32>,
+    pacing: Pacing,
+    stream: &impl RevolutionStream,
+    start: &Instant,
+    period_s: f64,
+) -> bool {
+    if let Some(queued) = backlog_bytes {
+        return stream
+            .bytes_per_revolution()
+            .is_some_and(|per_rev| queued > per_rev);
+    }
+    source.is_simulated()
+        && pacing == Pacing::RealTime
+        && start.elapsed().as_secs_f64() - stream.sensor_time_s() > period_s
+}
