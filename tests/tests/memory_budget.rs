@@ -159,6 +159,11 @@ fn buffers_in_code() -> Vec<(&'static str, usize, usize)> {
             size_of::<[f32; perception::raster::SCAN_COLUMNS]>(),
         ),
         (
+            "firmware::runner::B_WORKER_JOB_BYTES",
+            1,
+            firmware::runner::B_WORKER_JOB_BYTES,
+        ),
+        (
             "perception::raster::RASTER_LEN",
             perception::raster::RASTER_LEN,
             size_of::<f32>(),

@@ -23,6 +23,9 @@ use perception::yolo::MAX_DETECTIONS;
 
 use super::method_b::{MethodBScratch, MethodBSetup};
 
+/// Bytes of the one job buffer that goes back and forth (`memory-budget.md`).
+pub const B_WORKER_JOB_BYTES: usize = core::mem::size_of::<Job>();
+
 /// One round trip: three revolutions in, Method B's boxes out.
 pub(super) struct Job {
     /// The revolutions, newest first.

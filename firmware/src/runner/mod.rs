@@ -32,6 +32,7 @@ use perception::geometry::Pose2;
 use perception::method_a::MethodAConfig;
 use perception::tracks::TrackConfig;
 
+pub use b_worker::B_WORKER_JOB_BYTES;
 pub use history::{METHOD_B_HISTORY, ScanHistory};
 pub use method_b::{MethodBSetup, Network, Schedule};
 pub use summary::Summary;
