@@ -593,6 +593,7 @@ mod test {
         TrackConfig {
             motion: MotionConfig {
                 settle_s: 0.0,
+                still_frames: 0,
                 ..MotionConfig::default()
             },
             ..TrackConfig::default()
