@@ -88,6 +88,9 @@ pub struct RunOptions {
     pub world: Option<TrackConfig>,
 }
 
+/// Method B's stage budget on its own thread, in deadlines (at least).
+pub const WORKER_BUDGET_FRAMES: f64 = 3.0;
+
 /// Runs the loop until a limit, the end of the source, or the stop flag.
 pub fn run<S: RevolutionStream>(
     source: &mut LidarSource,
@@ -108,6 +111,12 @@ pub fn run<S: RevolutionStream>(
         && let Some(b) = opts.method_b.take()
     {
         st.worker = Some(b_worker::BWorker::start(b)?);
+        // Off the frame's path its budget is a cadence: a report at least every third frame
+        // (a Pi 3's projected slow end, 530 ms, is inside 750).
+        opts.budgets.method_b_ms = opts
+            .budgets
+            .method_b_ms
+            .max(WORKER_BUDGET_FRAMES * opts.budgets.deadline_ms);
     }
     let mut lp = FrameLoop {
         source,
