@@ -502,7 +502,10 @@ fn load_method_b(
     };
     let path = common.model.as_deref().or(cfg.method_b.model.as_deref());
     let model = YoloModel::load_or_builtin(path, opts).map_err(|e| (EXIT_USAGE, e.to_string()))?;
-    let board = crate::power::Board::this(cfg.power.board);
+    let board = crate::power::Board::this(
+        cfg.power.board,
+        crate::power::device_tree_model().as_deref(),
+    );
     let schedule = cfg
         .method_b
         .schedule

@@ -88,13 +88,11 @@ impl Board {
         }
     }
 
-    /// The board this runs on: the configured one, else the one the device tree names
-    /// (`None`: not a Pi we know).
-    pub fn this(cfg: Board) -> Option<Board> {
+    /// The board this runs on: the configured one, else the one `device_tree` (the contents
+    /// of `/proc/device-tree/model`, [`device_tree_model`]) names (`None`: not a Pi we know).
+    pub fn this(cfg: Board, device_tree: Option<&str>) -> Option<Board> {
         match cfg {
-            Board::Auto => device_tree_model()
-                .as_deref()
-                .and_then(Board::from_device_tree),
+            Board::Auto => device_tree.and_then(Board::from_device_tree),
             b => Some(b),
         }
     }
@@ -349,12 +347,8 @@ impl PowerMeter {
 
     /// The CPU-time model for the configured board, or the one `device_tree` names.
     pub fn model(cfg: &PowerSettings, device_tree: Option<&str>) -> PowerMeter {
-        let found = device_tree.and_then(Board::from_device_tree);
-        let (board, native) = match (cfg.board, found) {
-            (Board::Auto, Some(b)) => (b, true),
-            (Board::Auto, None) => (Board::Pi5, false),
-            (b, f) => (b, f == Some(b)),
-        };
+        let board = Board::this(cfg.board, device_tree).unwrap_or(Board::Pi5);
+        let native = device_tree.and_then(Board::from_device_tree) == Some(board);
         let source = if native {
             format!("model ({} figures, this board's CPU time)", board.name())
         } else {
@@ -438,7 +432,8 @@ impl Drop for PowerMeter {
     }
 }
 
-fn device_tree_model() -> Option<String> {
+/// The contents of `/proc/device-tree/model` (`None` off a board that has one).
+pub fn device_tree_model() -> Option<String> {
     std::fs::read_to_string("/proc/device-tree/model").ok()
 }
 

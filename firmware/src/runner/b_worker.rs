@@ -107,13 +107,16 @@ impl BWorker {
     /// The finished job, if one is ready; `f` reads it before it becomes the spare again.
     pub(super) fn poll(&mut self, f: impl FnOnce(&Job)) -> bool {
         match self.from_worker.try_recv() {
-            Ok(job) => {
-                f(&job);
-                self.spare = Some(job);
-                true
-            }
+            Ok(job) => self.take_back(job, f),
             Err(TryRecvError::Empty | TryRecvError::Disconnected) => false,
         }
+    }
+
+    /// `f` reads a finished job, which becomes the spare again.
+    fn take_back(&mut self, job: Box<Job>, f: impl FnOnce(&Job)) -> bool {
+        f(&job);
+        self.spare = Some(job);
+        true
     }
 
     /// Hands three revolutions (newest first) to the worker; `false` while it is still busy
@@ -143,11 +146,7 @@ impl BWorker {
             return false;
         }
         match self.from_worker.recv() {
-            Ok(job) => {
-                f(&job);
-                self.spare = Some(job);
-                true
-            }
+            Ok(job) => self.take_back(job, f),
             Err(_) => false,
         }
     }

@@ -95,11 +95,10 @@ pub const WORKER_BUDGET_FRAMES: f64 = 3.0;
 pub fn run<S: RevolutionStream>(
     source: &mut LidarSource,
     stream: S,
-    opts: RunOptions,
+    mut opts: RunOptions,
 ) -> Result<Summary, io::Error> {
     let start = Instant::now();
     let records = opts.sinks.iter().any(|s| s.records_input());
-    let mut opts = opts;
     let mut st = FrameState::new(records);
     // The LiDAR's pose on the robot, from whichever method has it.
     let mount = match (&opts.method_a, &opts.method_b) {
