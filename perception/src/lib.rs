@@ -27,6 +27,7 @@
 //! | [`fusion`]     | one frame's objects from both methods: A's, and B's joined or added |
 //! | [`sight`]      | what a revolution showed of a footprint (hidden, in view, seen empty) or a doorway |
 //! | [`motion`]     | a track's alpha–beta motion filter; walking legs told from furniture |
+//! | [`legs`]       | people's legs in a revolution: leg-sized free-standing blobs, paired |
 //! | [`tracks`]     | the world model's tracks: stable ids, association, evidence, negative evidence |
 //!
 //! Each capacity is a named constant listed in
@@ -41,6 +42,7 @@ pub mod doors;
 pub mod features;
 pub mod fusion;
 pub mod geometry;
+pub mod legs;
 pub mod map_doors;
 pub mod merge;
 pub mod method_a;

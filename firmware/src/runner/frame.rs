@@ -10,6 +10,7 @@ use perception::class::ObjectClass;
 use perception::cloud::Scan;
 use perception::fusion::{Evidence, FrameObjects, merge_b, push_a};
 use perception::geometry::{Point2, Pose2};
+use perception::legs::LegConfig;
 use perception::map_doors::{Doorways, MapDoorConfig};
 use perception::method_a::{MethodA, MethodAConfig};
 use perception::outline::drop_round_boxes;
@@ -407,9 +408,15 @@ impl<S: RevolutionStream> FrameLoop<'_, S> {
             );
             // Door frames in a doorway of the map's walls are openings in a wall.
             st.tracks.anchor_doors(&doorways);
+            // People: leg-sized blobs of this revolution off the map's walls, tracked; the
+            // ones that walk.
+            let mut persons =
+                perception::legs::persons(st.history.newest(), &lidar, &LegConfig::default());
+            persons.retain(|p| !st.wall_map.holds(p.centre));
+            st.tracks.update_walkers(frame, mid_s, &persons, cfg);
             st.people.clear();
-            for p in st.tracks.people(frame, cfg) {
-                st.people.push(PersonOut::track(p));
+            for p in st.tracks.walking(frame, cfg) {
+                st.people.push(PersonOut::walking(&p));
             }
             // Doors are map entries like objects: the confirmed door-frame tracks, whichever
             // method found them.

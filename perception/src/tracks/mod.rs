@@ -42,8 +42,10 @@ use crate::motion::{Motion, MotionConfig};
 use crate::sight::BINS;
 
 mod negative;
+mod walkers;
 
 pub use negative::Looked;
+pub use walkers::{MAX_WALKERS, SAME_PERSON_M, Walker, Walkers, Walking};
 
 /// Tracks held at most.
 pub const MAX_TRACKS: usize = 64;
@@ -248,6 +250,7 @@ pub struct Tracks {
     tracks: Vec<Track, MAX_TRACKS>,
     next_id: u32,
     stats: TrackStats,
+    walkers: Walkers,
 }
 
 impl Default for Tracks {
@@ -281,6 +284,7 @@ impl Tracks {
                 bad_poses: 0,
                 merged: 0,
             },
+            walkers: Walkers::new(),
         }
     }
 
