@@ -67,7 +67,12 @@ pub struct Person {
     pub id: usize,
     /// Midpoint of the two legs, map frame.
     pub at: Point2,
+    /// Clean returns on its legs in this revolution.
+    pub returns: u32,
 }
+
+/// A person is in view in a revolution that gave its legs at least this many returns.
+pub const PERSON_VISIBLE_RETURNS: u32 = 3;
 
 /// One frame's moving truth.
 #[derive(Debug, Clone, PartialEq, Default)]

@@ -8,9 +8,10 @@
 //! [`LegConfig::max_step_m`] of the last (a depth jump or a bin without a return ends it),
 //! whose width — the chord from first to last return plus one bin's spacing at that range —
 //! is that of a human leg, [`LegConfig::min_width_m`] to [`LegConfig::max_width_m`], within
-//! [`LegConfig::max_range_m`]. A run that is a piece of something longer (a wall broken by
-//! dropouts) is not a leg when a return within [`LegConfig::max_step_m`] continues it on
-//! either side across one missing bin. A **person** is two legs within
+//! [`LegConfig::max_range_m`]. A run that is a piece of something longer (a dark wall broken
+//! by dropouts) is not a leg: on one side or the other it goes on, return after return across
+//! gaps of up to [`LegConfig::max_dropout_bins`] missing bins, for [`LegConfig::max_chain_m`]
+//! or more. A **person** is two legs within
 //! [`LegConfig::max_pair_m`] (their midpoint), or one leg alone (one hides the other).
 
 use heapless::Vec;
@@ -41,6 +42,11 @@ pub struct LegConfig {
     pub max_range_m: f32,
     /// Two legs of one person are at most this far apart, m (a stride at shin height).
     pub max_pair_m: f32,
+    /// Missing bins across which a run is looked at as continued by the next return.
+    pub max_dropout_bins: usize,
+    /// A run continued (across dropouts) this far on either side is a piece of something
+    /// longer, m: more than a person's stance and a leg.
+    pub max_chain_m: f32,
 }
 
 impl Default for LegConfig {
@@ -52,6 +58,8 @@ impl Default for LegConfig {
             max_width_m: 0.25,
             max_range_m: 3.5,
             max_pair_m: 0.5,
+            max_dropout_bins: 4,
+            max_chain_m: 0.6,
         }
     }
 }
@@ -83,6 +91,40 @@ fn point(r: f32, d: i32) -> Point2 {
 /// Whether bins `a` and `b` (both with returns `ra`, `rb`) are steps of one surface.
 fn joined(ra: f32, a: i32, rb: f32, b: i32, cfg: &LegConfig) -> bool {
     point(ra, a).distance(point(rb, b)) <= cfg.max_step_m
+}
+
+/// Bins followed at most from a run's edge by [`chain`].
+const CHAIN_BINS: i32 = 40;
+
+/// How far from its edge (bin `edge`, range `r_edge`) a run goes on in direction `dir` (±1),
+/// return after return, each within the span of the bins missing before it (twice the bins'
+/// spacing, and at least two steps), across at most [`LegConfig::max_dropout_bins`] missing
+/// bins at a time, m.
+fn chain(ranges: &[f32; BINS], edge: i32, r_edge: f32, dir: i32, cfg: &LegConfig) -> f32 {
+    let start = point(r_edge, edge);
+    let (mut last, mut last_r, mut far, mut missing) = (start, r_edge, 0.0f32, 0usize);
+    for k in 1..=CHAIN_BINS {
+        let b = edge + dir * k;
+        match at(ranges, b) {
+            None => {
+                missing += 1;
+                if missing > cfg.max_dropout_bins {
+                    break;
+                }
+            }
+            Some(r) => {
+                let p = point(r, b);
+                let reach =
+                    ((missing + 1) as f32 * last_r * 2f32.to_radians()).max(2.0 * cfg.max_step_m);
+                if p.distance(last) > reach {
+                    break;
+                }
+                far = far.max(p.distance(start));
+                (last, last_r, missing) = (p, r, 0);
+            }
+        }
+    }
+    far
 }
 
 /// The leg candidates of a revolution (`ranges`, 1° bins), in the LiDAR's frame: each a run's
@@ -122,15 +164,11 @@ pub fn legs(ranges: &[f32; BINS], cfg: &LegConfig) -> Vec<Point2, MAX_LEGS> {
             let mean_r = sum.norm() / count as f32;
             let spacing = mean_r * 1f32.to_radians();
             let width = point(r0, d).distance(point(r_end, end)) + spacing;
-            // A run that a return past one missing bin continues is a piece of something
-            // longer (a wall with dropouts), not a thing of its own.
-            let continued = |edge: i32, r_edge: f32, gap: i32, beyond: i32| {
-                at(ranges, gap).is_none()
-                    && at(ranges, beyond).is_some_and(|r| {
-                        point(r_edge, edge).distance(point(r, beyond)) <= 2.0 * cfg.max_step_m
-                    })
-            };
-            let piece = continued(d, r0, d - 1, d - 2) || continued(end, r_end, end + 1, end + 2);
+            // A run that goes on past a few missing bins, return after return, for longer
+            // than any person's stance is a piece of something longer: a dark wall's dashes
+            // between dropouts.
+            let piece = chain(ranges, d, r0, -1, cfg) >= cfg.max_chain_m
+                || chain(ranges, end, r_end, 1, cfg) >= cfg.max_chain_m;
             if !piece
                 && mean_r <= cfg.max_range_m
                 && (cfg.min_width_m..=cfg.max_width_m).contains(&width)
@@ -276,6 +314,17 @@ mod test {
         assert!(legs(&scan(&[], &room(), 0), &cfg).is_empty());
         let l = legs(&scan(&[], &room(), 3), &cfg);
         assert!(l.is_empty(), "{l:?}");
+        // A darker one: runs of three returns between gaps of one to four bins.
+        for gap in 1..=4usize {
+            let mut dashes = scan(&[], &room(), 0);
+            for (d, r) in dashes.iter_mut().enumerate() {
+                if d % (3 + gap) >= 3 {
+                    *r = 0.0;
+                }
+            }
+            let l = legs(&dashes, &cfg);
+            assert!(l.is_empty(), "gaps of {gap}: {l:?}");
+        }
         // A 0.4 m box face-on at 1.5 m.
         let face = [(Point2::new(1.5, -0.2), Point2::new(1.5, 0.2))];
         let mut both = room().to_vec();

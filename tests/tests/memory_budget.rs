@@ -139,6 +139,21 @@ fn buffers_in_code() -> Vec<(&'static str, usize, usize)> {
             size_of::<perception::tracks::Track>(),
         ),
         (
+            "perception::tracks::MAX_WALKERS",
+            perception::tracks::MAX_WALKERS,
+            size_of::<perception::tracks::Walker>(),
+        ),
+        (
+            "perception::legs::MAX_LEGS",
+            perception::legs::MAX_LEGS,
+            size_of::<Point2>(),
+        ),
+        (
+            "perception::legs::MAX_PERSONS",
+            perception::legs::MAX_PERSONS,
+            size_of::<perception::legs::Person>(),
+        ),
+        (
             "perception::wall_map::MAX_MAP_WALLS",
             perception::wall_map::MAX_MAP_WALLS,
             size_of::<perception::wall_map::MapWall>(),

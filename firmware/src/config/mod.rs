@@ -324,6 +324,9 @@ pub struct WorldSettings {
     pub settle_s: f32,
     /// Tell walking people from furniture (moving tracks go to `people`, never `objects`).
     pub people: bool,
+    /// Look for people's legs in every revolution (`perception::legs`): a walk they make is a
+    /// person in `people` even when neither method took the legs for furniture.
+    pub legs: bool,
 }
 
 impl Default for WorldSettings {
@@ -333,6 +336,7 @@ impl Default for WorldSettings {
             enabled: true,
             settle_s: m.settle_s,
             people: true,
+            legs: true,
         }
     }
 }
@@ -349,6 +353,7 @@ impl WorldSettings {
         if !self.people {
             c.motion.moving_m = f32::INFINITY;
         }
+        c.walkers = self.people && self.legs;
         c
     }
 }

@@ -119,7 +119,9 @@ impl FrameState {
             power_peak: 0.0,
             objects: Vec::with_capacity(perception::tracks::MAX_TRACKS),
             detections: Vec::with_capacity(perception::fusion::MAX_FRAME_OBJECTS),
-            people: Vec::with_capacity(perception::tracks::MAX_TRACKS),
+            people: Vec::with_capacity(
+                perception::tracks::MAX_TRACKS + perception::tracks::MAX_WALKERS,
+            ),
             walls: Vec::with_capacity(perception::walls::MAX_SEGMENTS),
             doors: Vec::with_capacity(
                 perception::doors::MAX_DOORS + perception::tracks::MAX_TRACKS,
@@ -410,10 +412,12 @@ impl<S: RevolutionStream> FrameLoop<'_, S> {
             st.tracks.anchor_doors(&doorways);
             // People: leg-sized blobs of this revolution off the map's walls, tracked; the
             // ones that walk.
-            let mut persons =
-                perception::legs::persons(st.history.newest(), &lidar, &LegConfig::default());
-            persons.retain(|p| !st.wall_map.holds(p.centre));
-            st.tracks.update_walkers(frame, mid_s, &persons, cfg);
+            if cfg.walkers {
+                let mut persons =
+                    perception::legs::persons(st.history.newest(), &lidar, &LegConfig::default());
+                persons.retain(|p| !st.wall_map.holds(p.centre));
+                st.tracks.update_walkers(frame, mid_s, &persons, cfg);
+            }
             st.people.clear();
             for p in st.tracks.walking(frame, cfg) {
                 st.people.push(PersonOut::walking(&p));

@@ -142,13 +142,14 @@ pub fn generate(seed: u64, seconds: f64, tour: bool, lidar: LidarModel) -> Gener
         frame.rpm = rpm;
         frame.t_start_s = t;
         let mut through_old = 0;
-        let mid_people: Vec<Person> = plan
+        let mut mid_people: Vec<Person> = plan
             .walkers
             .iter()
             .enumerate()
             .map(|(id, w)| Person {
                 id,
                 at: to_map.transform(w.at((t + 180.0 * dt) as f32).0),
+                returns: 0,
             })
             .collect();
         for i in 0..READINGS_PER_REV {
@@ -190,6 +191,7 @@ pub fn generate(seed: u64, seconds: f64, tour: bool, lidar: LidarModel) -> Gener
                         }
                     }
                     Some((Owner::Jamb(k), _)) => door_returns[k] += 1,
+                    Some((Owner::Person(k), _)) => mid_people[k].returns += 1,
                     _ => {}
                 }
                 if let (Some((piece, f_move)), None) = (moved, seen_empty)

@@ -356,10 +356,14 @@ pub fn report(outcomes: &[Outcome]) -> String {
             "  walking people: {} reports as furniture over {} frames with a person{}",
             t.people_as_furniture,
             t.people_frames,
-            if t.people_found[0] > 0 {
+            if t.people_found[0] > 0 || t.people_phantoms > 0 {
                 format!(
-                    "; `people` found {}/{}",
-                    t.people_found[1], t.people_found[0]
+                    "; `people` found {}/{} ({}/{} in view), {} people where nobody walks",
+                    t.people_found[1],
+                    t.people_found[0],
+                    t.people_in_view_found[1],
+                    t.people_in_view_found[0],
+                    t.people_phantoms
                 )
             } else {
                 String::new()

@@ -8,7 +8,7 @@ use perception::geometry::Point2;
 use serde_json::Value;
 
 use crate::eval_a::class_index;
-use crate::run_truth::{Furniture, RunTruth};
+use crate::run_truth::{Furniture, PERSON_VISIBLE_RETURNS, Person, RunTruth};
 
 /// A reported object is on a piece of furniture when within this distance of its footprint.
 pub const MATCH_M: f32 = 0.3;
@@ -158,8 +158,15 @@ pub struct Tally {
     pub people_as_furniture: u32,
     /// See `people_as_furniture`.
     pub people_frames: u32,
-    /// Frames × people in view of a `people` list, and how many it had within reach.
+    /// Frames × people of a `people` list, and how many it had within reach.
     pub people_found: [u32; 2],
+    /// The same for the people in view (legs with at least `PERSON_VISIBLE_RETURNS` returns
+    /// in the revolution).
+    #[serde(default)]
+    pub people_in_view_found: [u32; 2],
+    /// `people` entries with no walking person within reach.
+    #[serde(default)]
+    pub people_phantoms: u32,
 }
 
 /// Class names of the tally's per-class arrays.
@@ -252,10 +259,16 @@ pub fn score_run(truth: &RunTruth, lines: &[Line], tally: &mut Tally) {
             tally.det_phantoms = ph;
         }
         if let Some(found) = &line.people {
+            let hit = |p: &&Person| found.iter().any(|q| q.distance(p.at) <= PERSON_M);
+            let in_view = |p: &&Person| p.returns >= PERSON_VISIBLE_RETURNS;
             tally.people_found[0] += people.len() as u32;
-            tally.people_found[1] += people
+            tally.people_found[1] += people.iter().filter(hit).count() as u32;
+            tally.people_in_view_found[0] += people.iter().filter(in_view).count() as u32;
+            tally.people_in_view_found[1] +=
+                people.iter().filter(in_view).filter(hit).count() as u32;
+            tally.people_phantoms += found
                 .iter()
-                .filter(|p| found.iter().any(|q| q.distance(p.at) <= PERSON_M))
+                .filter(|q| people.iter().all(|p| q.distance(p.at) > PERSON_M))
                 .count() as u32;
         }
         // Identity: furniture alive and already visible vs reported furniture-class objects.
@@ -447,7 +460,8 @@ impl Tally {
             move_stuck,
             move_unseen,
             people_as_furniture,
-            people_frames
+            people_frames,
+            people_phantoms
         );
         sum_arr!(
             map_tp,
@@ -458,7 +472,12 @@ impl Tally {
             doors,
             phantoms
         );
-        sum_arr!(det_phantoms, people_found, phantoms_by_class);
+        sum_arr!(
+            det_phantoms,
+            people_found,
+            people_in_view_found,
+            phantoms_by_class
+        );
         self.move_gone_s.extend_from_slice(&o.move_gone_s);
     }
 

@@ -91,6 +91,8 @@ pub struct TrackConfig {
     pub max_observation_m: f32,
     /// What makes a track a walking person's (never furniture).
     pub motion: MotionConfig,
+    /// Track the leg detector's person candidates ([`Tracks::update_walkers`]).
+    pub walkers: bool,
 }
 
 impl Default for TrackConfig {
@@ -112,6 +114,7 @@ impl Default for TrackConfig {
             max_range_m: 3.5,
             max_observation_m: 12.0,
             motion: MotionConfig::default(),
+            walkers: true,
         }
     }
 }
