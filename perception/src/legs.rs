@@ -11,7 +11,8 @@
 //! [`LegConfig::max_range_m`]. A run that is a piece of something longer (a dark wall broken
 //! by dropouts) is not a leg: on one side or the other it goes on, return after return across
 //! gaps of up to [`LegConfig::max_dropout_bins`] missing bins, for [`LegConfig::max_chain_m`]
-//! or more. A **person** is two legs within
+//! or more; nor is a run with something nearer right beside it (background seen through a
+//! gap, such as a wall between a chair's legs). A **person** is two legs within
 //! [`LegConfig::max_pair_m`] (their midpoint), or one leg alone (one hides the other).
 
 use heapless::Vec;
@@ -129,6 +130,14 @@ fn chain(ranges: &[f32; BINS], edge: i32, r_edge: f32, dir: i32, cfg: &LegConfig
     far
 }
 
+/// Whether the first return within two bins past a run's edge (bin `edge`, range `r_edge`)
+/// in direction `dir` is nearer than the edge by more than a leg's depth.
+fn nearer_beside(ranges: &[f32; BINS], edge: i32, r_edge: f32, dir: i32) -> bool {
+    (1..=2)
+        .find_map(|k| at(ranges, edge + dir * k))
+        .is_some_and(|r| r < r_edge - 0.1)
+}
+
 /// The leg candidates of a revolution (`ranges`, 1° bins), in the LiDAR's frame: each a run's
 /// centre pushed half its width back along its bearing (the leg's axis, not its skin).
 pub fn legs(ranges: &[f32; BINS], cfg: &LegConfig) -> Vec<Point2, MAX_LEGS> {
@@ -171,7 +180,12 @@ pub fn legs(ranges: &[f32; BINS], cfg: &LegConfig) -> Vec<Point2, MAX_LEGS> {
             // between dropouts.
             let piece = chain(ranges, d, r0, -1, cfg) >= cfg.max_chain_m
                 || chain(ranges, end, r_end, 1, cfg) >= cfg.max_chain_m;
+            // A leg stands in front of what is beside it: a run with something nearer right
+            // beside it is background seen through a gap (a wall between a person's or a
+            // chair's legs).
+            let behind = nearer_beside(ranges, d, r0, -1) || nearer_beside(ranges, end, r_end, 1);
             if !piece
+                && !behind
                 && mean_r <= cfg.max_range_m
                 && (cfg.min_width_m..=cfg.max_width_m).contains(&width)
             {
@@ -274,7 +288,8 @@ mod test {
     }
 
     fn room() -> [(Point2, Point2); 4] {
-        let (x0, x1, y0, y1) = (-3.0, 4.0, -3.5, 3.0);
+        // Within the 2.5 m the legs are looked for on every side.
+        let (x0, x1, y0, y1) = (-1.6, 2.1, -1.8, 1.5);
         [
             (Point2::new(x0, y0), Point2::new(x1, y0)),
             (Point2::new(x1, y0), Point2::new(x1, y1)),
@@ -286,7 +301,7 @@ mod test {
     #[test]
     fn two_legs_make_one_person_between_them() {
         let cfg = LegConfig::default();
-        for (dist, bearing) in [(1.0f32, 0.3f32), (1.8, -1.2), (2.4, 2.5)] {
+        for (dist, bearing) in [(0.8f32, 0.3f32), (1.2, -1.2), (1.3, 2.5)] {
             let c = Point2::from_polar(dist, bearing);
             let side = Point2::from_polar(0.12, bearing + core::f32::consts::FRAC_PI_2);
             let legs = [(c + side, 0.06), (c - side, 0.06)];
@@ -333,7 +348,7 @@ mod test {
         both.extend_from_slice(&face);
         assert!(legs(&scan(&[], &both, 0), &cfg).is_empty());
         // A chair's four 0.015 m legs, 0.4 m apart, at 1–2 m.
-        for at in [1.0f32, 2.0] {
+        for at in [0.6f32, 1.4] {
             let chair: [(Point2, f32); 4] = [(0.0, 0.0), (0.4, 0.0), (0.0, 0.4), (0.4, 0.4)]
                 .map(|(x, y)| (Point2::new(at + x, y - 0.2), 0.015));
             assert!(legs(&scan(&chair, &room(), 0), &cfg).is_empty(), "{at} m");
