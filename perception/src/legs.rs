@@ -11,8 +11,8 @@
 //! [`LegConfig::max_range_m`]. A run that is a piece of something longer (a dark wall broken
 //! by dropouts) is not a leg: on one side or the other it goes on, return after return across
 //! gaps of up to [`LegConfig::max_dropout_bins`] missing bins, for [`LegConfig::max_chain_m`]
-//! or more; nor is a run with something nearer right beside it (background seen through a
-//! gap, such as a wall between a chair's legs). A **person** is two legs within
+//! or more. Background seen through a gap (a wall between a person's legs) can pass as a
+//! leg; it stands still. A **person** is two legs within
 //! [`LegConfig::max_pair_m`] (their midpoint), or one leg alone (one hides the other).
 
 use heapless::Vec;
@@ -130,14 +130,6 @@ fn chain(ranges: &[f32; BINS], edge: i32, r_edge: f32, dir: i32, cfg: &LegConfig
     far
 }
 
-/// Whether the first return within two bins past a run's edge (bin `edge`, range `r_edge`)
-/// in direction `dir` is nearer than the edge by more than a leg's depth.
-fn nearer_beside(ranges: &[f32; BINS], edge: i32, r_edge: f32, dir: i32) -> bool {
-    (1..=2)
-        .find_map(|k| at(ranges, edge + dir * k))
-        .is_some_and(|r| r < r_edge - 0.1)
-}
-
 /// The leg candidates of a revolution (`ranges`, 1° bins), in the LiDAR's frame: each a run's
 /// centre pushed half its width back along its bearing (the leg's axis, not its skin).
 pub fn legs(ranges: &[f32; BINS], cfg: &LegConfig) -> Vec<Point2, MAX_LEGS> {
@@ -180,12 +172,7 @@ pub fn legs(ranges: &[f32; BINS], cfg: &LegConfig) -> Vec<Point2, MAX_LEGS> {
             // between dropouts.
             let piece = chain(ranges, d, r0, -1, cfg) >= cfg.max_chain_m
                 || chain(ranges, end, r_end, 1, cfg) >= cfg.max_chain_m;
-            // A leg stands in front of what is beside it: a run with something nearer right
-            // beside it is background seen through a gap (a wall between a person's or a
-            // chair's legs).
-            let behind = nearer_beside(ranges, d, r0, -1) || nearer_beside(ranges, end, r_end, 1);
             if !piece
-                && !behind
                 && mean_r <= cfg.max_range_m
                 && (cfg.min_width_m..=cfg.max_width_m).contains(&width)
             {
@@ -306,9 +293,18 @@ mod test {
             let side = Point2::from_polar(0.12, bearing + core::f32::consts::FRAC_PI_2);
             let legs = [(c + side, 0.06), (c - side, 0.06)];
             let p = persons(&scan(&legs, &room(), 0), &Pose2::IDENTITY, &cfg);
-            assert_eq!(p.len(), 1, "{dist} m: {p:?}");
-            assert_eq!(p[0].legs, 2);
-            assert!(p[0].centre.distance(c) < 0.06, "{dist} m: {:?}", p[0]);
+            // The person; a piece of the wall seen between the legs may come as a lone "leg"
+            // (it stands still: the walkers never list it), nothing else.
+            let near: heapless::Vec<&Person, 4> =
+                p.iter().filter(|q| q.centre.distance(c) < 0.3).collect();
+            assert_eq!(near.len(), 1, "{dist} m: {p:?}");
+            assert_eq!(near[0].legs, 2);
+            assert!(near[0].centre.distance(c) < 0.06, "{dist} m: {:?}", near[0]);
+            assert!(p.len() <= 2, "{dist} m: {p:?}");
+            assert!(
+                p.iter()
+                    .all(|q| q.legs == 2 || q.centre.norm() > dist + 0.3)
+            );
         }
     }
 
@@ -347,11 +343,12 @@ mod test {
         let mut both = room().to_vec();
         both.extend_from_slice(&face);
         assert!(legs(&scan(&[], &both, 0), &cfg).is_empty());
-        // A chair's four 0.015 m legs, 0.4 m apart, at 1–2 m.
+        // A chair's four 0.015 m legs, 0.4 m apart.
         for at in [0.6f32, 1.4] {
             let chair: [(Point2, f32); 4] = [(0.0, 0.0), (0.4, 0.0), (0.0, 0.4), (0.4, 0.4)]
                 .map(|(x, y)| (Point2::new(at + x, y - 0.2), 0.015));
-            assert!(legs(&scan(&chair, &room(), 0), &cfg).is_empty(), "{at} m");
+            // (No room behind: a wall seen between them comes out in pieces, which stand still.)
+            assert!(legs(&scan(&chair, &[], 0), &cfg).is_empty(), "{at} m");
         }
     }
 
