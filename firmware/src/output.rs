@@ -6,7 +6,7 @@ use std::io::{self, Write};
 use drivers::lidar::{LidarFaults, Revolution};
 use perception::class::ObjectClass;
 use perception::fusion::{Evidence, FrameObject};
-use perception::tracks::{Track, Walking};
+use perception::tracks::{Track, Walker};
 use serde::{Serialize, Serializer};
 
 /// Pose in the map frame.
@@ -142,15 +142,27 @@ pub struct PersonOut {
 }
 
 impl PersonOut {
-    /// From someone walking (a walker of the leg detector, or a furniture track that walked).
-    pub fn walking(w: &Walking) -> Self {
+    /// From a moving track.
+    pub fn track(t: &Track) -> Self {
         PersonOut {
-            id: w.id,
-            x: f64::from(w.pos.x),
-            y: f64::from(w.pos.y),
-            vx: f64::from(w.vel.x),
-            vy: f64::from(w.vel.y),
-            score: f64::from(w.score),
+            id: t.id,
+            x: f64::from(t.centre.x),
+            y: f64::from(t.centre.y),
+            vx: f64::from(t.motion.vel.x),
+            vy: f64::from(t.motion.vel.y),
+            score: belief(t),
+        }
+    }
+
+    /// From a walker of the leg detector that walks, listed as `id`.
+    pub fn walker(id: u32, w: &Walker) -> Self {
+        PersonOut {
+            id,
+            x: f64::from(w.motion.pos.x),
+            y: f64::from(w.motion.pos.y),
+            vx: f64::from(w.motion.vel.x),
+            vy: f64::from(w.motion.vel.y),
+            score: f64::from(w.score()),
         }
     }
 }

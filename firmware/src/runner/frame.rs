@@ -15,7 +15,7 @@ use perception::map_doors::{Doorways, MapDoorConfig};
 use perception::method_a::{MethodA, MethodAConfig};
 use perception::outline::drop_round_boxes;
 use perception::plausible::{drop_in_map_walls, drop_walled};
-use perception::tracks::{Looked, Tracks};
+use perception::tracks::{Looked, PEOPLE_FRAMES, Tracks};
 use perception::wall_map::WallMap;
 use perception::wall_piece::drop_wall_pieces;
 
@@ -419,8 +419,11 @@ impl<S: RevolutionStream> FrameLoop<'_, S> {
                 st.tracks.update_walkers(frame, mid_s, &persons, cfg);
             }
             st.people.clear();
-            for p in st.tracks.walking(frame, cfg) {
-                st.people.push(PersonOut::walking(&p));
+            for (id, w) in st.tracks.walkers().people(frame, PEOPLE_FRAMES) {
+                st.people.push(PersonOut::walker(id, w));
+            }
+            for t in st.tracks.people(frame, cfg) {
+                st.people.push(PersonOut::track(t));
             }
             // Doors are map entries like objects: the confirmed door-frame tracks, whichever
             // method found them.

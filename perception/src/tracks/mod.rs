@@ -45,7 +45,7 @@ mod negative;
 mod walkers;
 
 pub use negative::Looked;
-pub use walkers::{MAX_WALKERS, SAME_PERSON_M, Walker, Walkers, Walking};
+pub use walkers::{MAX_WALKERS, SAME_PERSON_M, Walker, Walkers};
 
 /// Tracks held at most.
 pub const MAX_TRACKS: usize = 64;
@@ -262,6 +262,29 @@ impl Default for Tracks {
     }
 }
 
+/// The cheapest (track `i`, observation `k`) pair neither of which is taken yet (`matched`,
+/// `used`), by `cost` (`None`: they cannot be one); ties go to the first found, tracks in
+/// order, then observations. Both tables associate greedily on the global minimum with it.
+fn cheapest(
+    matched: &[bool],
+    used: &[bool],
+    tracks: usize,
+    obs: usize,
+    cost: impl Fn(usize, usize) -> Option<f32>,
+) -> Option<(usize, usize)> {
+    let mut best: Option<(f32, usize, usize)> = None;
+    for i in (0..tracks).filter(|&i| !matched[i]) {
+        for k in (0..obs).filter(|&k| !used[k]) {
+            if let Some(c) = cost(i, k)
+                && best.is_none_or(|b| c < b.0)
+            {
+                best = Some((c, i, k));
+            }
+        }
+    }
+    best.map(|(_, i, k)| (i, k))
+}
+
 /// Class compatibility cost: `None` when the two cannot be one object.
 fn class_cost(track: ObjectClass, obs: ObjectClass, cfg: &TrackConfig) -> Option<f32> {
     use ObjectClass::DoorFrame;
@@ -301,12 +324,16 @@ impl Tracks {
         self.tracks.iter().filter(|t| t.confirmed)
     }
 
-    /// The people: moving tracks seen in one of the last [`PEOPLE_FRAMES`] frames up to
-    /// `frame`, with at least [`TrackConfig::confirm_hits`] hits.
+    /// The people among the tracks: moving tracks seen in one of the last [`PEOPLE_FRAMES`]
+    /// frames up to `frame`, with at least [`TrackConfig::confirm_hits`] hits, and no listed
+    /// walker ([`Walkers::people`]) within [`SAME_PERSON_M`] (that one is the same person).
     pub fn people(&self, frame: u64, cfg: &TrackConfig) -> impl Iterator<Item = &Track> + '_ {
         let hits = cfg.confirm_hits;
         self.tracks.iter().filter(move |t| {
-            t.motion.moving && t.hits >= hits && frame.saturating_sub(t.last_seen) < PEOPLE_FRAMES
+            t.motion.moving
+                && t.hits >= hits
+                && frame.saturating_sub(t.last_seen) < PEOPLE_FRAMES
+                && !self.walker_near(frame, t.centre)
         })
     }
 
@@ -355,39 +382,23 @@ impl Tracks {
             *a = t.motion.predict(stamp_s, &cfg.motion);
         }
         // Greedy on the global minimum cost.
-        loop {
-            let mut best: Option<(f32, usize, usize)> = None;
-            for (i, t) in self.tracks.iter().enumerate() {
-                if matched[i] {
-                    continue;
-                }
-                for (k, o) in obs.iter().enumerate() {
-                    if used[k] {
-                        continue;
-                    }
-                    // Looked for where it stands, or where its walk has taken it.
-                    let d = t.centre.distance(o.centre).min(ahead[i].distance(o.centre));
-                    // A desk's centre moves with the view more than a chair's (its legs
-                    // come and go behind each other): desks gate at their own radius.
-                    let desks = t.class() == ObjectClass::Desk && o.class == ObjectClass::Desk;
-                    let gate = if desks {
-                        cfg.gate_m.max(class_radius(ObjectClass::Desk))
-                    } else {
-                        cfg.gate_m
-                    };
-                    if d > gate {
-                        continue;
-                    }
-                    let Some(extra) = class_cost(t.class(), o.class, cfg) else {
-                        continue;
-                    };
-                    let cost = d + extra;
-                    if best.is_none_or(|b| cost < b.0) {
-                        best = Some((cost, i, k));
-                    }
-                }
+        while let Some((i, k)) = cheapest(&matched, &used, self.tracks.len(), obs.len(), |i, k| {
+            let (t, o) = (&self.tracks[i], &obs[k]);
+            // Looked for where it stands, or where its walk has taken it.
+            let d = t.centre.distance(o.centre).min(ahead[i].distance(o.centre));
+            // A desk's centre moves with the view more than a chair's (its legs come and go
+            // behind each other): desks gate at their own radius.
+            let desks = t.class() == ObjectClass::Desk && o.class == ObjectClass::Desk;
+            let gate = if desks {
+                cfg.gate_m.max(class_radius(ObjectClass::Desk))
+            } else {
+                cfg.gate_m
+            };
+            if d > gate {
+                return None;
             }
-            let Some((_, i, k)) = best else { break };
+            class_cost(t.class(), o.class, cfg).map(|extra| d + extra)
+        }) {
             matched[i] = true;
             used[k] = true;
             Self::hit(&mut self.tracks[i], &obs[k], frame, stamp_s, cfg);

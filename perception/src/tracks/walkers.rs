@@ -86,27 +86,17 @@ impl Walkers {
         for (a, w) in ahead.iter_mut().zip(self.list.iter()) {
             *a = w.motion.predict(stamp_s, cfg);
         }
-        loop {
-            let mut best: Option<(f32, usize, usize)> = None;
-            for (i, w) in self.list.iter().enumerate() {
-                if matched[i] {
-                    continue;
-                }
-                for (k, p) in persons.iter().enumerate() {
-                    if used[k] {
-                        continue;
-                    }
-                    let d = w
-                        .motion
-                        .pos
-                        .distance(p.centre)
-                        .min(ahead[i].distance(p.centre));
-                    if d <= WALKER_GATE_M && best.is_none_or(|b| d < b.0) {
-                        best = Some((d, i, k));
-                    }
-                }
-            }
-            let Some((_, i, k)) = best else { break };
+        while let Some((i, k)) =
+            super::cheapest(&matched, &used, self.list.len(), persons.len(), |i, k| {
+                let (w, p) = (&self.list[i], &persons[k]);
+                let d = w
+                    .motion
+                    .pos
+                    .distance(p.centre)
+                    .min(ahead[i].distance(p.centre));
+                (d <= WALKER_GATE_M).then_some(d)
+            })
+        {
             matched[i] = true;
             used[k] = true;
             let w = &mut self.list[i];
@@ -142,29 +132,17 @@ impl Walkers {
         }
     }
 
-    /// The people: walkers that walk, seen in one of the last `recent` frames up to `frame`.
-    pub fn people(&self, frame: u64, recent: u64) -> impl Iterator<Item = &Walker> + '_ {
+    /// The people: walkers that walk, with their ids, seen in one of the last `recent` frames
+    /// up to `frame`.
+    pub fn people(&self, frame: u64, recent: u64) -> impl Iterator<Item = (u32, &Walker)> + '_ {
         self.list
             .iter()
-            .filter(move |w| w.id.is_some() && frame.saturating_sub(w.last_seen) < recent)
+            .filter(move |w| frame.saturating_sub(w.last_seen) < recent)
+            .filter_map(|w| Some((w.id?, w)))
     }
 }
 
-/// A person as the output line lists one: from a walker, or from a furniture track that walked.
-#[derive(Debug, Clone, Copy, PartialEq)]
-#[cfg_attr(feature = "defmt", derive(defmt::Format))]
-pub struct Walking {
-    /// Id (shared with the objects' ids: never reused).
-    pub id: u32,
-    /// Where, map frame, m.
-    pub pos: Point2,
-    /// Velocity, map frame, m/s.
-    pub vel: Point2,
-    /// Confidence in [0, 1].
-    pub score: f32,
-}
-
-/// A furniture track that walked and a walker this close are one person, m.
+/// A furniture track that walked and a listed walker this close are one person, m.
 pub const SAME_PERSON_M: f32 = 0.5;
 
 impl Tracks {
@@ -186,29 +164,12 @@ impl Tracks {
         &self.walkers
     }
 
-    /// Everyone walking, seen in one of the last [`PEOPLE_FRAMES`] frames: the walkers that
-    /// walk, then the furniture tracks that walked where no such walker is.
-    pub fn walking(&self, frame: u64, cfg: &TrackConfig) -> impl Iterator<Item = Walking> + '_ {
-        let walkers = self.walkers.people(frame, PEOPLE_FRAMES).map(|w| Walking {
-            id: w.id.unwrap_or_default(),
-            pos: w.motion.pos,
-            vel: w.motion.vel,
-            score: w.score(),
-        });
-        let tracks = self
-            .people(frame, cfg)
-            .filter(move |t| {
-                self.walkers
-                    .people(frame, PEOPLE_FRAMES)
-                    .all(|w| w.motion.pos.distance(t.centre) > SAME_PERSON_M)
-            })
-            .map(|t| Walking {
-                id: t.id,
-                pos: t.centre,
-                vel: t.motion.vel,
-                score: 1.0 / (1.0 + libm::expf(-t.existence)),
-            });
-        walkers.chain(tracks)
+    /// Whether a walker listed at `frame` is within [`SAME_PERSON_M`] of `p` (a furniture
+    /// track that walked there is that person, listed once).
+    pub fn walker_near(&self, frame: u64, p: Point2) -> bool {
+        self.walkers
+            .people(frame, PEOPLE_FRAMES)
+            .any(|(_, w)| w.motion.pos.distance(p) <= SAME_PERSON_M)
     }
 }
 
@@ -255,17 +216,61 @@ mod test {
             // 1 m/s along x, the legs' midpoint jittering ±0.05 m.
             let jitter = if f % 2 == 0 { 0.05 } else { -0.05 };
             t.update_walkers(f, s, &[person(-1.0 + s as f32, 1.0 + jitter)], &cfg);
-            let people: heapless::Vec<Walking, 4> = t.walking(f, &cfg).collect();
+            let people: heapless::Vec<(u32, &Walker), 4> =
+                t.walkers().people(f, PEOPLE_FRAMES).collect();
             assert!(people.len() <= 1);
-            if let Some(p) = people.first() {
-                listed.get_or_insert((f, p.id));
-                assert_eq!(p.id, listed.unwrap().1, "the id stays");
-                assert!((p.vel.x - 1.0).abs() < 0.3 && p.vel.y.abs() < 0.3, "{p:?}");
+            assert_eq!(t.people(f, &cfg).count(), 0);
+            if let Some(&(id, p)) = people.first() {
+                listed.get_or_insert((f, id));
+                assert_eq!(id, listed.unwrap().1, "the id stays");
+                let v = p.motion.vel;
+                assert!((v.x - 1.0).abs() < 0.3 && v.y.abs() < 0.3, "{p:?}");
             }
         }
         let (f, id) = listed.expect("the walk is listed");
         assert!(f <= 14, "listed after {f} frames");
         assert_ne!(id, t.all()[0].id, "its own id");
+    }
+
+    #[test]
+    fn a_person_both_tables_follow_is_listed_once() {
+        let cfg = TrackConfig::default();
+        let (mut both, mut tracks_only) = (Tracks::new(), Tracks::new());
+        let (mut from_walkers, mut from_tracks, mut alone) = (0, 0, 0);
+        for f in 0..30u64 {
+            let s = f as f64 * 0.2;
+            let at = Point2::new(-1.0 + s as f32, 1.0);
+            // The legs taken for a chair by both methods, and found by the leg detector.
+            let legs = FrameObject {
+                class: ObjectClass::Chair,
+                centre: at,
+                score: 0.9,
+                evidence: Evidence::AB,
+                bbox: None,
+                width_m: 0.3,
+            };
+            for t in [&mut both, &mut tracks_only] {
+                t.update(
+                    f,
+                    s,
+                    &[legs],
+                    &Pose2::IDENTITY,
+                    &[0.0; BINS],
+                    Looked::BOTH,
+                    &cfg,
+                );
+            }
+            both.update_walkers(f, s, &[person(at.x, at.y)], &cfg);
+            let w = both.walkers().people(f, PEOPLE_FRAMES).count();
+            let t = both.people(f, &cfg).count();
+            assert!(w + t <= 1, "frame {f}: listed twice");
+            from_walkers += w;
+            from_tracks += t;
+            alone += tracks_only.people(f, &cfg).count();
+        }
+        assert!(alone > 0, "the furniture track walks on its own");
+        assert!(from_walkers > 0);
+        assert!(from_tracks < alone, "a walker there takes its place");
     }
 
     #[test]
@@ -283,7 +288,8 @@ mod test {
                 person(0.0, -1.5 - j),
             ];
             t.update_walkers(f, f as f64 * 0.2, &seen, &cfg);
-            assert_eq!(t.walking(f, &cfg).count(), 0, "frame {f}");
+            assert_eq!(t.walkers().people(f, PEOPLE_FRAMES).count(), 0, "frame {f}");
+            assert_eq!(t.people(f, &cfg).count(), 0, "frame {f}");
         }
         assert_eq!(t.walkers().all().len(), 3);
     }
