@@ -410,6 +410,8 @@ impl<S: RevolutionStream> FrameLoop<'_, S> {
             );
             // Door frames in a doorway of the map's walls are openings in a wall.
             st.tracks.anchor_doors(&doorways);
+            // How wide the boxes look: a bin or a post is narrower than any box.
+            st.tracks.measure_widths(&lidar, &returns);
             // People: leg-sized blobs of this revolution off the map's walls, tracked; the
             // ones that walk.
             if cfg.walkers {
@@ -432,6 +434,10 @@ impl<S: RevolutionStream> FrameLoop<'_, S> {
                 // A track that the map's walls now hold is a piece of wall: no hit will come
                 // (its detections are dropped above) and it fades; it is not reported meanwhile.
                 if t.class() != ObjectClass::DoorFrame && st.wall_map.holds(t.centre) {
+                    continue;
+                }
+                // A "box" never seen as wide as a box is a bin or a pillar.
+                if t.too_narrow() {
                     continue;
                 }
                 let o = ObjectOut::track(t);

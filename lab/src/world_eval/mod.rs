@@ -325,6 +325,12 @@ pub fn report(outcomes: &[Outcome]) -> String {
             f64::from(t.phantoms_by_class[2]) / f,
             f64::from(t.phantoms_by_class[3]) / f
         );
+        let places: Vec<String> = score::PHANTOM_PLACES
+            .iter()
+            .zip(&t.phantoms_where)
+            .map(|(name, &n)| format!("{name} {:.3}", f64::from(n) / f))
+            .collect();
+        let _ = writeln!(s, "    where they lie: {}", places.join(", "));
         if t.det_frames > 0 {
             let _ = writeln!(
                 s,

@@ -16,6 +16,20 @@ pub const MATCH_M: f32 = 0.3;
 pub const DOOR_MATCH_M: f32 = 0.5;
 /// A reported object is on a walking person when within this distance of the legs' midpoint.
 pub const PERSON_M: f32 = 0.4;
+/// A phantom lies on a piece of clutter when within this distance of its centre.
+pub const CLUTTER_M: f32 = 0.5;
+/// A phantom lies beside a piece of furniture when within this distance of its footprint.
+pub const BESIDE_M: f32 = 0.8;
+/// A phantom lies at a doorway when within this distance of its centre.
+pub const DOORWAY_M: f32 = 1.0;
+/// Names of `Tally::phantoms_where`.
+pub const PHANTOM_PLACES: [&str; 5] = [
+    "clutter",
+    "beside furniture",
+    "doorway",
+    "wall face",
+    "open",
+];
 
 /// One reported object.
 #[derive(Debug, Clone, PartialEq)]
@@ -134,6 +148,12 @@ pub struct Tally {
     pub phantoms_at_wall: u32,
     /// See `phantoms_at_wall`.
     pub phantoms_by_class: [u32; 4],
+    /// Phantoms (among `objects`) by what they lie on, first that applies: a piece of clutter
+    /// (within `CLUTTER_M` of its centre), beside furniture (within `BESIDE_M` of a footprint:
+    /// an offset or a second report of one piece), at a doorway (within `DOORWAY_M` of its
+    /// centre), at a wall face (within 0.15 m), anywhere else. Names: `PHANTOM_PLACES`.
+    #[serde(default)]
+    pub phantoms_where: [u32; 5],
     /// Reported objects on furniture of another class (and none of their own within reach).
     pub wrong_class: u32,
     /// Frames with a `detections` list, and the phantoms among those detections by source.
@@ -177,6 +197,33 @@ fn on_furniture<'a>(
     p: Point2,
 ) -> impl Iterator<Item = &'a &'a Furniture> + 'a {
     alive.iter().filter(move |f| f.distance(p) <= MATCH_M)
+}
+
+/// Where a phantom at `p` lies: an index into `PHANTOM_PLACES`.
+fn phantom_place(truth: &RunTruth, alive: &[&Furniture], p: Point2) -> usize {
+    if truth
+        .clutter
+        .iter()
+        .any(|(c, _)| c.distance(p) <= CLUTTER_M)
+    {
+        0
+    } else if alive.iter().any(|f| f.distance(p) <= BESIDE_M) {
+        1
+    } else if truth
+        .doors
+        .iter()
+        .any(|d| d.centre.distance(p) <= DOORWAY_M)
+    {
+        2
+    } else if truth
+        .walls
+        .iter()
+        .any(|(a, b)| p.distance_to_segment(*a, *b) <= 0.15)
+    {
+        3
+    } else {
+        4
+    }
 }
 
 /// Optimal one-to-one assignment maximising total weight (Hungarian, via `pathfinding`).
@@ -223,6 +270,10 @@ pub fn score_run(truth: &RunTruth, lines: &[Line], tally: &mut Tally) {
                             .any(|d| d.centre.distance(o.at) <= DOOR_MATCH_M)
                         {
                             phantoms[o.source] += 1;
+                            if main {
+                                tally.phantoms_by_class[3] += 1;
+                                tally.phantoms_where[phantom_place(truth, &alive, o.at)] += 1;
+                            }
                         }
                     }
                     c => {
@@ -238,6 +289,7 @@ pub fn score_run(truth: &RunTruth, lines: &[Line], tally: &mut Tally) {
                                 if let Some(c) = c {
                                     tally.phantoms_by_class[c as usize] += 1;
                                 }
+                                tally.phantoms_where[phantom_place(truth, &alive, o.at)] += 1;
                             }
                             if main && people.iter().any(|p| p.at.distance(o.at) <= PERSON_M) {
                                 tally.people_as_furniture += 1;
@@ -476,7 +528,8 @@ impl Tally {
             det_phantoms,
             people_found,
             people_in_view_found,
-            phantoms_by_class
+            phantoms_by_class,
+            phantoms_where
         );
         self.move_gone_s.extend_from_slice(&o.move_gone_s);
     }
@@ -644,6 +697,42 @@ mod test {
         assert_eq!(s.map_tp, [0, 0, 0]);
         assert_eq!(s.map_visible, [1, 0, 0]);
         assert_eq!(s.map_reported, [0, 2, 1]);
+    }
+
+    #[test]
+    fn phantoms_are_placed_on_what_they_lie_on() {
+        let mut t = truth();
+        t.clutter.push((Point2::new(3.0, -2.0), "pillar".into()));
+        t.walls
+            .push((Point2::new(-5.0, 3.0), Point2::new(5.0, 3.0)));
+        let line = Line {
+            t: 0.0,
+            objects: vec![
+                obj(1, ObjectClass::Box, 3.2, -2.0),      // on the pillar
+                obj(2, ObjectClass::Chair, 1.0, 0.7),     // 0.5 m from the chair's edge
+                obj(3, ObjectClass::DoorFrame, 0.0, 1.4), // 0.6 m from the doorway's centre
+                obj(4, ObjectClass::Box, 3.5, 2.9),       // at the wall face
+                obj(5, ObjectClass::Desk, -3.0, -2.0),    // nowhere
+                obj(6, ObjectClass::Chair, 1.0, 0.1),     // on the chair: no phantom
+            ],
+            ..Line::default()
+        };
+        let mut s = Tally::default();
+        score_run(&t, &[line], &mut s);
+        // The door frame is 0.1 m further from the doorway than `DOOR_MATCH_M`.
+        assert_eq!(s.phantoms_where, [1, 1, 1, 1, 1]);
+        assert_eq!(s.phantoms_by_class, [1, 2, 1, 1]);
+        let far_frame = Line {
+            t: 0.2,
+            objects: vec![obj(3, ObjectClass::DoorFrame, 0.0, 2.8)],
+            ..Line::default()
+        };
+        let mut s = Tally::default();
+        score_run(&t, &[far_frame], &mut s);
+        assert_eq!(
+            (s.phantoms_where, s.phantoms_by_class),
+            ([0, 0, 1, 0, 0], [0, 0, 0, 1])
+        );
     }
 
     #[test]

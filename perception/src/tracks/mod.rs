@@ -50,6 +50,9 @@ pub use walkers::{MAX_WALKERS, SAME_PERSON_M, Walker, Walkers};
 /// Tracks held at most.
 pub const MAX_TRACKS: usize = 64;
 
+/// Narrow views before a "box" never seen box-wide is not reported ([`Track::too_narrow`]).
+pub const NARROW_VIEWS: u16 = 3;
+
 /// A person is listed while seen in one of this many frames.
 pub const PEOPLE_FRAMES: u64 = 3;
 
@@ -156,6 +159,11 @@ pub struct Track {
     /// A door frame the map's walls have shown as a doorway (a gap seen through): an opening
     /// in a wall, which rays passing through do not speak against.
     pub anchored: bool,
+    /// Revolutions in which its returns looked wider than any box's short side, and narrower
+    /// than it, while it was a box ([`Tracks::measure_widths`]).
+    pub box_wide_views: u16,
+    /// See `box_wide_views`.
+    pub narrow_views: u16,
 }
 
 impl Track {
@@ -187,6 +195,16 @@ impl Track {
             (false, true) => Evidence::B,
             _ => Evidence::A,
         }
+    }
+
+    /// A "box" whose returns looked narrower than any box in [`NARROW_VIEWS`] revolutions and
+    /// never as wide as one: a bin, a round pillar, a post ([`crate::outline::box_wide`]).
+    /// Not reported while so. Something in front narrows a box, nothing widens a post: one
+    /// box-wide view outweighs any number of narrow ones.
+    pub fn too_narrow(&self) -> bool {
+        self.class() == ObjectClass::Box
+            && self.box_wide_views == 0
+            && self.narrow_views >= NARROW_VIEWS
     }
 
     /// Radius of the footprint negative evidence looks across, m (a desk's legs span ~1.8 m).
@@ -450,6 +468,8 @@ impl Tracks {
                 width_m: 0.0,
                 motion: Motion::new(o.centre, stamp_s),
                 anchored: false,
+                box_wide_views: 0,
+                narrow_views: 0,
             };
             Self::hit(&mut t, o, frame, stamp_s, cfg);
             if self.tracks.push(t).is_ok() {
@@ -548,6 +568,8 @@ impl Tracks {
                     t.width_m = gone.width_m;
                 }
                 t.anchored |= gone.anchored;
+                t.box_wide_views = t.box_wide_views.saturating_add(gone.box_wide_views);
+                t.narrow_views = t.narrow_views.saturating_add(gone.narrow_views);
                 self.tracks.swap_remove(g);
                 self.stats.merged += 1;
                 if g == i {
@@ -556,6 +578,21 @@ impl Tracks {
                 }
             }
             i += 1;
+        }
+    }
+
+    /// Box tracks that stand still: whether their returns in this revolution look as wide as
+    /// a box ([`crate::outline::box_wide`]; `pts` from [`crate::sight::returns`], `lidar` the
+    /// LiDAR's pose in the map), counted into [`Track::too_narrow`]'s views.
+    pub fn measure_widths(&mut self, lidar: &Pose2, pts: &[Option<Point2>; BINS]) {
+        for t in self.tracks.iter_mut() {
+            if t.class() == ObjectClass::Box && !t.motion.moving {
+                match crate::outline::box_wide(t.centre, lidar, pts) {
+                    Some(true) => t.box_wide_views = t.box_wide_views.saturating_add(1),
+                    Some(false) => t.narrow_views = t.narrow_views.saturating_add(1),
+                    None => {}
+                }
+            }
         }
     }
 
@@ -636,6 +673,58 @@ mod test {
     }
 
     const CHAIR: ObjectClass = ObjectClass::Chair;
+
+    #[test]
+    fn a_box_as_narrow_as_a_post_is_not_reported_until_seen_box_wide() {
+        let mut t = Tracks::new();
+        let cfg = quick();
+        // Something 2 m ahead across `half` bins either side of 0°, the rest of the room at 4 m.
+        let thing = |half: usize| {
+            let mut r = ranges(4.0);
+            for d in 0..=half {
+                r[d] = 2.0;
+                r[(BINS - d) % BINS] = 2.0;
+            }
+            crate::sight::returns(&r)
+        };
+        let seen = obs(ObjectClass::Box, 2.05, 0.0, 0.9, Evidence::AB);
+        for f in 0..10 {
+            step(&mut t, f, &[seen], &Pose2::IDENTITY, &ranges(4.0), &cfg);
+            // A post of 0.14 m (4 bins at 2 m).
+            t.measure_widths(&Pose2::IDENTITY, &thing(2));
+        }
+        let b = t.confirmed().next().expect("confirmed");
+        assert!(b.narrow_views >= NARROW_VIEWS && b.too_narrow(), "{b:?}");
+        // Seen once 0.42 m wide (12 bins), it is a box for good: something in front of a box
+        // narrows it, nothing widens a post.
+        t.measure_widths(&Pose2::IDENTITY, &thing(6));
+        t.measure_widths(&Pose2::IDENTITY, &thing(1));
+        let b = t.confirmed().next().expect("confirmed");
+        assert!(!b.too_narrow(), "{b:?}");
+        // Two narrow views are not enough.
+        let mut two = Tracks::new();
+        for f in 0..10 {
+            step(&mut two, f, &[seen], &Pose2::IDENTITY, &ranges(4.0), &cfg);
+            if f < 2 {
+                two.measure_widths(&Pose2::IDENTITY, &thing(2));
+            }
+        }
+        assert!(!two.confirmed().next().expect("confirmed").too_narrow());
+        // Chairs are four posts: the rule is the box's alone.
+        let mut c = Tracks::new();
+        for f in 0..10 {
+            step(
+                &mut c,
+                f,
+                &[obs(CHAIR, 2.05, 0.0, 0.9, Evidence::AB)],
+                &Pose2::IDENTITY,
+                &ranges(4.0),
+                &cfg,
+            );
+            c.measure_widths(&Pose2::IDENTITY, &thing(2));
+        }
+        assert!(!c.confirmed().next().expect("confirmed").too_narrow());
+    }
 
     #[test]
     fn ids_are_stable_and_tracks_confirm_after_three_hits() {
