@@ -103,6 +103,17 @@ fn near_run(
     best
 }
 
+/// `centre` (map frame) in the LiDAR's frame, its range and the spacing of two bins there, m;
+/// None when not a number or on the LiDAR itself.
+fn seen_from(centre: Point2, lidar: &Pose2) -> Option<(Point2, f32, f32)> {
+    if !(centre.x.is_finite() && centre.y.is_finite()) {
+        return None;
+    }
+    let c = lidar.inverse().transform(centre);
+    let range = c.norm();
+    (range >= 0.05).then(|| (c, range, range * core::f32::consts::PI / 180.0))
+}
+
 /// Whether the detection at `centre` (map frame) looks as wide as a box from `lidar`: its
 /// silhouette is the bearing span of the longest unbroken run of returns within
 /// [`WIDTH_NEAR_M`] of it, times its range (from the bins' bearings, not the returns'
@@ -114,17 +125,9 @@ fn near_run(
 /// A rectangle's silhouette is never narrower than its short side, from any direction; a round
 /// thing's is its diameter. Something in front can only narrow it.
 pub fn box_wide(centre: Point2, lidar: &Pose2, pts: &[Option<Point2>; BINS]) -> Option<bool> {
-    if !(centre.x.is_finite() && centre.y.is_finite()) {
-        return None;
-    }
-    let c = lidar.inverse().transform(centre);
-    let range = c.norm();
-    if range < 0.05 {
-        return None;
-    }
+    let (c, range, spacing) = seen_from(centre, lidar)?;
     // Neighbours on one surface: three bins' spacing, or the range noise (2.5 % of range in
     // the simulator) between two returns, whichever is more.
-    let spacing = range * core::f32::consts::PI / 180.0;
     let link = (3.0 * spacing).max(0.06 + 0.05 * range);
     let (run, first, last) = near_run(c, pts, WIDTH_NEAR_M + 0.05 * range, link, true);
     if run.len() < 3 {
@@ -139,12 +142,9 @@ pub fn box_wide(centre: Point2, lidar: &Pose2, pts: &[Option<Point2>; BINS]) -> 
             pts[b].is_some_and(|p| p.norm() < end_range - link)
         })
     };
-    if width + spacing < MIN_BOX_WIDTH_M && (hidden(first, -1) || hidden(last, 1)) {
-        return None;
-    }
     if width - spacing >= MIN_BOX_WIDTH_M {
         Some(true)
-    } else if width + spacing < MIN_BOX_WIDTH_M {
+    } else if width + spacing < MIN_BOX_WIDTH_M && !hidden(first, -1) && !hidden(last, 1) {
         Some(false)
     } else {
         None
@@ -153,15 +153,9 @@ pub fn box_wide(centre: Point2, lidar: &Pose2, pts: &[Option<Point2>; BINS]) -> 
 
 /// [`is_round`] on the revolution's returns already converted ([`returns`]).
 fn is_round_in(centre: Point2, lidar: &Pose2, pts: &[Option<Point2>; BINS]) -> bool {
-    if !(centre.x.is_finite() && centre.y.is_finite()) {
+    let Some((c, _, spacing)) = seen_from(centre, lidar) else {
         return false;
-    }
-    let c = lidar.inverse().transform(centre);
-    let range = c.norm();
-    if range < 0.05 {
-        return false;
-    }
-    let spacing = range * core::f32::consts::PI / 180.0;
+    };
     let (best, _, _) = near_run(c, pts, NEAR_M, (3.0 * spacing).max(0.06), false);
     if best.len() < MIN_POINTS {
         return false;

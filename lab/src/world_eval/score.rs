@@ -16,6 +16,8 @@ pub const MATCH_M: f32 = 0.3;
 pub const DOOR_MATCH_M: f32 = 0.5;
 /// A reported object is on a walking person when within this distance of the legs' midpoint.
 pub const PERSON_M: f32 = 0.4;
+/// A phantom lies at a wall face when within this distance of it.
+pub const WALL_FACE_M: f32 = 0.15;
 /// A phantom lies on a piece of clutter when within this distance of its centre.
 pub const CLUTTER_M: f32 = 0.5;
 /// A phantom lies beside a piece of furniture when within this distance of its footprint.
@@ -199,6 +201,14 @@ fn on_furniture<'a>(
     alive.iter().filter(move |f| f.distance(p) <= MATCH_M)
 }
 
+/// Whether `p` lies within `WALL_FACE_M` of a wall face.
+fn at_wall_face(truth: &RunTruth, p: Point2) -> bool {
+    truth
+        .walls
+        .iter()
+        .any(|(a, b)| p.distance_to_segment(*a, *b) <= WALL_FACE_M)
+}
+
 /// Where a phantom at `p` lies: an index into `PHANTOM_PLACES`.
 fn phantom_place(truth: &RunTruth, alive: &[&Furniture], p: Point2) -> usize {
     if truth
@@ -215,11 +225,7 @@ fn phantom_place(truth: &RunTruth, alive: &[&Furniture], p: Point2) -> usize {
         .any(|d| d.centre.distance(p) <= DOORWAY_M)
     {
         2
-    } else if truth
-        .walls
-        .iter()
-        .any(|(a, b)| p.distance_to_segment(*a, *b) <= 0.15)
-    {
+    } else if at_wall_face(truth, p) {
         3
     } else {
         4
@@ -281,11 +287,7 @@ pub fn score_run(truth: &RunTruth, lines: &[Line], tally: &mut Tally) {
                         if near.peek().is_none() {
                             phantoms[o.source] += 1;
                             if main {
-                                let at_wall = truth
-                                    .walls
-                                    .iter()
-                                    .any(|(a, b)| o.at.distance_to_segment(*a, *b) <= 0.15);
-                                tally.phantoms_at_wall += u32::from(at_wall);
+                                tally.phantoms_at_wall += u32::from(at_wall_face(truth, o.at));
                                 if let Some(c) = c {
                                     tally.phantoms_by_class[c as usize] += 1;
                                 }
