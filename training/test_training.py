@@ -7,6 +7,10 @@ environment, `.venv/bin/python training/test_training.py DATASET/data.yaml`).
 * the logits head: the shipped checkpoint exported with Ultralytics' full head, and the same
   graph cut by `logits_head.py` with the DFL, anchors and sigmoid done in numpy as
   `perception::yolo::decode` does them, give the same 1 x 8 x 504 on real rasters.
+* quantisation-aware training (`qat.py`): the shipped checkpoint with its convolutions
+  fake-quantised on N calibration images must compute what onnxruntime's int8 export,
+  calibrated on the same N images, computes — far closer to it than the float model is (the
+  rest is the integer accumulators' rounding, about one output step).
 """
 
 import shutil
@@ -93,7 +97,46 @@ def test_logits_head(data: Path) -> None:
     print(f"logits head: {len(images)} images, largest difference {worst:.2e}")
 
 
+def test_qat_emulates_int8(data: Path, calib: int = 32) -> None:
+    import onnxruntime as ort
+    import torch
+    from ultralytics import YOLO
+
+    import qat
+    from export import png_tensor, quantise
+
+    tmp = Path(tempfile.mkdtemp())
+    shutil.copy(HERE.parent / "models/yolo/umbra-yolov8n.pt", tmp / "m.pt")
+    f32 = tmp / "m.onnx"
+    import logits_head
+
+    logits_head.cut(Path(YOLO(str(tmp / "m.pt")).export(
+        format="onnx", imgsz=(64, 384), opset=17, simplify=True, dynamic=False, batch=1,
+        device="cpu")), f32)
+    folder = data.parent / "images" / "train"
+    quantise(f32, tmp / "m8.onnx", folder, calib)
+    model = YOLO(str(tmp / "m.pt")).model.float().eval()
+    n = qat.prepare(model, qat.calibration_tensors(folder, calib))
+    model.eval()
+    run = {k: ort.InferenceSession(str(f), providers=["CPUExecutionProvider"])
+           for k, f in (("fp32", f32), ("int8", tmp / "m8.onnx"))}
+    emulated_off, float_off = [], []
+    for f in sorted((data.parent / "images" / "test").glob("*.png"))[:10]:
+        x = png_tensor(f)
+        with torch.no_grad():
+            d = model(torch.from_numpy(x))[1]
+        emu = torch.cat([d["boxes"], d["scores"]], 1).numpy()
+        int8 = run["int8"].run(None, {"images": x})[0]
+        emulated_off.append(float(np.abs(emu - int8).mean()))
+        float_off.append(float(np.abs(run["fp32"].run(None, {"images": x})[0] - int8).mean()))
+    e, fl = float(np.mean(emulated_off)), float(np.mean(float_off))
+    assert n > 60, f"only {n} convolutions fake-quantised"
+    assert e < 0.35 * fl, f"emulation off int8 by {e:.3f}, float by {fl:.3f}"
+    print(f"qat: {n} convolutions; mean |emulated - int8| {e:.3f}, |float - int8| {fl:.3f}")
+
+
 if __name__ == "__main__":
+    test_qat_emulates_int8(Path(sys.argv[1]))
     test_logits_head(Path(sys.argv[1]))
     test_shuffled(Path(sys.argv[1]))
     print("ok")

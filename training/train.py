@@ -37,7 +37,7 @@ SCHEDULE = dict(optimizer="AdamW", lr0=0.00125, lrf=0.01, momentum=0.937, weight
 def train(data: Path, epochs: int, batch: int = 32, seed: int = 0, device: str = "cpu",
           workers: int = 2, name: str = "small", resume: bool = False, mirror: float = 0.5,
           init: Path | None = None, lr0: float | None = None, cache: str | bool = "ram",
-          hours: float | None = None, amp: bool = False) -> Path:
+          hours: float | None = None, amp: bool = False, trainer=ExactTrainer) -> Path:
     """Train (or resume) one run; returns its weights folder.
 
     Every image is 64 x 384, so the `rect` batch shapes are all equal and Ultralytics keeps the
@@ -46,7 +46,8 @@ def train(data: Path, epochs: int, batch: int = 32, seed: int = 0, device: str =
 
     `hours` caps the run's wall time (Ultralytics' `time`: the epoch count is refitted to it after
     each epoch, and the cosine schedule with it). `amp` is off unless asked for: Ultralytics'
-    AMP check downloads a model, which an offline machine cannot.
+    AMP check downloads a model, which an offline machine cannot. `trainer` is `ExactTrainer`
+    or a subclass of it (`qat.py`'s).
     """
     sched = dict(SCHEDULE)
     if lr0 is not None:
@@ -56,17 +57,17 @@ def train(data: Path, epochs: int, batch: int = 32, seed: int = 0, device: str =
         # undoes a trained model (seen: val mAP50 0.96 -> 0.27 after one short epoch): biases
         # start at lr0 instead.
         sched.update(warmup_epochs=0.2, warmup_bias_lr=sched["lr0"], cos_lr=True)
-    ExactTrainer.mirror_p = mirror
+    trainer.mirror_p = mirror
     weights = HERE / "runs" / name / "weights"
     if resume:
-        YOLO(str(weights / "last.pt")).train(resume=True, trainer=ExactTrainer)
+        YOLO(str(weights / "last.pt")).train(resume=True, trainer=trainer)
     else:
         YOLO(str(HERE / "yolov8n-umbra.yaml")).train(
             data=str(Path(data).resolve()), imgsz=384, rect=True, epochs=epochs, batch=batch,
             workers=workers, device=device, seed=seed, deterministic=True,
             pretrained=str(init) if init else False, amp=amp, plots=False,
             project=str(HERE / "runs"), name=name, exist_ok=True, val=True,
-            trainer=ExactTrainer, cache=cache, **({"time": hours} if hours else {}),
+            trainer=trainer, cache=cache, **({"time": hours} if hours else {}),
             **sched, **OFF,
         )
     return weights

@@ -1,0 +1,205 @@
+"""Quantisation-aware fine-tuning: train the network through the int8 model's own rounding.
+
+    python training/qat.py --data DATASET/data.yaml --init checkpoints/var25.pt \
+        --calib DATASET/images/train --epochs 2 --lr0 0.0001 --name qat1
+    python training/qat.py --strip runs/qat1/weights/last.pt checkpoints/qat1.pt
+
+The shipped int8 model (`export.py`) is onnxruntime's static quantisation of the convolutions
+only, in QOperator form (`QLinearConv`), per tensor — the form tract runs in integer. Each
+convolution, batch norm folded in, reads its input as uint8 and writes its output as uint8
+(asymmetric, the range the min and max over the calibration images), with int8 weights
+(symmetric, the range the largest weight). Applied after training, that rounding cost var21
+to var25 0.07–0.13 mAP50-95 (`models/README.md`), and per-channel weights or a float head
+won back only part of it.
+
+Here every one of those convolutions runs through the same rounding while it trains (fake
+quantisation, straight-through gradients): batch norm folded with its running statistics
+(frozen, as at export), the folded weights rounded to int8 on their largest value, input and
+output rounded to uint8 on ranges measured once, before training, over the same calibration
+images the export uses. The DFL's fixed convolution is not in the exported graph (the runtime
+decodes it in float) and is left alone. Ultralytics' own QAT (ModelOpt) quantises per channel
+and exports Q/DQ nodes, which tract runs in float: not the model we ship.
+
+`--strip` writes an ordinary Ultralytics checkpoint (the fake quantisation taken out, optimizer
+state dropped); `export.py` makes its fp32 and int8 files like any other's.
+"""
+
+import argparse
+import sys
+import time
+from pathlib import Path
+
+import offline  # noqa: F401  (must come before ultralytics)
+import torch
+import torch.nn.functional as F
+from torch import nn
+
+import train as train_mod
+from exact import ExactTrainer
+from ultralytics.nn.modules import Conv
+
+# The int8 model's integer ranges: activations uint8, weights int8 symmetric (onnxruntime
+# quantises weights on [-127, 127]).
+A_MIN, A_MAX = 0, 255
+W_MAX = 127
+
+
+def fq_act(x: torch.Tensor, lo: float, hi: float) -> torch.Tensor:
+    """`x` rounded as onnxruntime's uint8 activations on the range [lo, hi] (0 always inside)."""
+    lo, hi = min(lo, 0.0), max(hi, 0.0)
+    scale = max((hi - lo) / (A_MAX - A_MIN), 1e-8)
+    zero = int(round(A_MIN - lo / scale))
+    return torch.fake_quantize_per_tensor_affine(x, scale, zero, A_MIN, A_MAX)
+
+
+def fq_weight(w: torch.Tensor) -> torch.Tensor:
+    """`w` rounded as int8 per tensor on its largest magnitude (symmetric, zero point 0)."""
+    scale = max(float(w.detach().abs().max()) / W_MAX, 1e-12)
+    return torch.fake_quantize_per_tensor_affine(w, scale, 0, -W_MAX, W_MAX)
+
+
+class QConv(Conv):
+    """Ultralytics' Conv (conv, batch norm, SiLU) as the int8 export computes it."""
+
+    def forward(self, x):
+        bn, conv = self.bn, self.conv
+        g = bn.weight / torch.sqrt(bn.running_var + bn.eps)
+        w = conv.weight * g.view(-1, 1, 1, 1)
+        b = bn.bias - bn.running_mean * g
+        r = self.q_range.tolist()
+        y = F.conv2d(fq_act(x, r[0], r[1]), fq_weight(w), b, conv.stride, conv.padding,
+                     conv.dilation, conv.groups)
+        return self.act(fq_act(y, r[2], r[3]))
+
+
+class QConv2d(nn.Conv2d):
+    """A bare convolution (the head's outputs) as the int8 export computes it."""
+
+    def forward(self, x):
+        r = self.q_range.tolist()
+        y = F.conv2d(fq_act(x, r[0], r[1]), fq_weight(self.weight), self.bias, self.stride,
+                     self.padding, self.dilation, self.groups)
+        return fq_act(y, r[2], r[3])
+
+
+def quantised_layers(model: nn.Module):
+    """(name, module, output-producing module) of every convolution the int8 export quantises."""
+    for name, m in model.named_modules():
+        if ".dfl" in name or name.endswith("dfl"):
+            continue
+        if isinstance(m, Conv) and isinstance(getattr(m, "bn", None), nn.BatchNorm2d):
+            yield name, m, m.bn
+    for name, m in model.named_modules():
+        if type(m) is nn.Conv2d and ".dfl" not in name and not name.endswith(".conv"):
+            yield name, m, m
+
+
+def calibration_tensors(folder: Path, n: int) -> list[torch.Tensor]:
+    """The first `n` PNGs of `folder` in name order, as `export.py` calibrates on them."""
+    from export import png_tensor
+
+    files = sorted(folder.glob("*.png"))[:n]
+    if not files:
+        raise SystemExit(f"no calibration PNGs in {folder}")
+    return [torch.from_numpy(png_tensor(f)) for f in files]
+
+
+@torch.no_grad()
+def prepare(model: nn.Module, images: list[torch.Tensor]) -> int:
+    """Measures each quantised convolution's input and output range over `images` and turns it
+    into its fake-quantised class. Returns how many layers were prepared."""
+    layers = list(quantised_layers(model))
+    seen: dict[str, list[float]] = {name: [0.0, 0.0, 0.0, 0.0] for name, _, _ in layers}
+    hooks = []
+    for name, m, out in layers:
+        def on_in(mod, args, name=name):
+            x = args[0]
+            r = seen[name]
+            r[0], r[1] = min(r[0], float(x.min())), max(r[1], float(x.max()))
+
+        def on_out(mod, args, y, name=name):
+            r = seen[name]
+            r[2], r[3] = min(r[2], float(y.min())), max(r[3], float(y.max()))
+
+        hooks += [m.register_forward_pre_hook(on_in), out.register_forward_hook(on_out)]
+    was = model.training
+    model.eval()
+    for x in images:
+        model(x)
+    for h in hooks:
+        h.remove()
+    model.train(was)
+    for name, m, _ in layers:
+        m.register_buffer("q_range", torch.tensor(seen[name], dtype=torch.float32))
+        m.__class__ = QConv if isinstance(m, Conv) else QConv2d
+    return len(layers)
+
+
+def strip(model: nn.Module) -> int:
+    """Takes the fake quantisation out again (the classes and their ranges). Returns a count."""
+    n = 0
+    for m in model.modules():
+        if isinstance(m, (QConv, QConv2d)):
+            m.__class__ = Conv if isinstance(m, QConv) else nn.Conv2d
+            del m.q_range
+            n += 1
+    return n
+
+
+class QATTrainer(ExactTrainer):
+    """The exact-shape trainer whose model trains through the int8 rounding."""
+
+    calib: list[torch.Tensor] = []
+
+    def get_model(self, cfg=None, weights=None, verbose=True):
+        model = super().get_model(cfg, weights, verbose)
+        n = prepare(model, self.calib)
+        print(f"qat: {n} convolutions fake-quantised on {len(self.calib)} calibration images")
+        return model
+
+
+def strip_checkpoint(src: Path, dst: Path) -> None:
+    ckpt = torch.load(str(src), map_location="cpu", weights_only=False)
+    model = ckpt.get("ema") or ckpt["model"]
+    n = strip(model.float())
+    ckpt.update(model=model.half(), ema=None, optimizer=None, updates=None,
+                train_results=None)
+    torch.save(ckpt, str(dst))
+    print(f"wrote {dst}: {n} layers back to float convolutions")
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--data")
+    ap.add_argument("--init", type=Path, help="the float checkpoint to fine-tune")
+    ap.add_argument("--calib", type=Path, help="folder of training PNGs (export.py's)")
+    ap.add_argument("--calib-images", type=int, default=256)
+    ap.add_argument("--epochs", type=int, default=2)
+    ap.add_argument("--batch", type=int, default=32)
+    ap.add_argument("--lr0", type=float, default=1e-4)
+    ap.add_argument("--seed", type=int, default=0)
+    ap.add_argument("--workers", type=int, default=2)
+    ap.add_argument("--device", default="cpu")
+    ap.add_argument("--name", default="qat")
+    ap.add_argument("--resume", action="store_true", help="continue runs/NAME/weights/last.pt")
+    ap.add_argument("--strip", nargs=2, type=Path, metavar=("IN", "OUT"),
+                    help="write IN as an ordinary checkpoint OUT and stop")
+    a = ap.parse_args()
+    if a.strip:
+        strip_checkpoint(*a.strip)
+        return
+    if not (a.data and (a.init or a.resume) and a.calib):
+        ap.error("--data, --init (or --resume) and --calib are needed to train")
+    # The trainer and layer classes from the module `qat`, not `__main__`, so that the
+    # checkpoints it pickles load from any script that imports `qat`.
+    import qat
+
+    qat.QATTrainer.calib = calibration_tensors(a.calib, a.calib_images)
+    t0 = time.time()
+    w = train_mod.train(Path(a.data), a.epochs, a.batch, a.seed, a.device, a.workers, a.name,
+                        a.resume, init=a.init, lr0=a.lr0, trainer=qat.QATTrainer)
+    print(f"trained in {time.time() - t0:.0f} s: {w}", file=sys.stderr)
+
+
+if __name__ == "__main__":
+    main()
