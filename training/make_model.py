@@ -168,9 +168,15 @@ def card(a, work: Path, info: dict) -> None:
               f"{info['ultralytics']}, torch {info['torch']}; {info['hardware']}; "
               f"{info['train_s']:,.0f} s of training. Checkpoint: `best.pt` (highest val "
               "fitness)."]
-    L += ["- **Export:** fp32 ONNX opset 17, simplified; int8 QOperator, convolutions only, "
-         "per-tensor, calibrated on the first 256 training images (`training/export.py`).",
-         "", "**Held-out test scenarios** (Rust evaluator `umbra-lab eval-b`, fp32):", ""]
+    if info.get("int8_weights"):
+        L += ["- **Export:** fp32 ONNX opset 17, simplified, from the weights above. int8 "
+              "QOperator, convolutions only, per-tensor (`training/export.py`), from other "
+              f"weights: {info['int8_lineage']}; calibrated on the first 256 PNGs of "
+              f"`{info['calib']}`, the images the fine-tuning measured its ranges on."]
+    else:
+        L += ["- **Export:** fp32 ONNX opset 17, simplified; int8 QOperator, convolutions only, "
+              "per-tensor, calibrated on the first 256 training images (`training/export.py`)."]
+    L += ["", "**Held-out test scenarios** (Rust evaluator `umbra-lab eval-b`, fp32):", ""]
     L += table(ev["train/umbra-yolov8n.onnx"])
     L += ["", "**Second test set, unseen room kind** (fp32):", ""]
     L += table(ev["ood/umbra-yolov8n.onnx"])
@@ -182,13 +188,15 @@ def card(a, work: Path, info: dict) -> None:
             m = ev[f"{name}/{model}"]
             L.append(f"| {label} | {model} | {m['map50']:.4f} | {m['map50_95']:.4f} | "
                      f"{u['map50']:.4f} / {u['map50_95']:.4f} |")
-    study = [(label, ev[f"{name}/umbra-yolov8n.onnx"].get("study_rule"))
-             for name, label in (("train", "held-out"), ("ood", "unseen kind"))]
-    if all(m for _, m in study):
+    study = [(label, model, ev[f"{name}/{model}"].get("study_rule"))
+             for name, label in (("train", "held-out"), ("ood", "unseen kind"))
+             for model in ("umbra-yolov8n.onnx", "umbra-yolov8n-int8.onnx")]
+    if all(m for _, _, m in study):
         L += ["", "**The study's ruler** (`umbra-lab eval-b`: our true boxes and the model's "
               "widened as the study's label generator draws them, + 20 px wide and + 12 px tall, "
-              "clamped; fp32):", "", "| set | mAP50 | mAP50-95 |", "|---|---|---|"]
-        L += [f"| {label} | {m['map50']:.4f} | {m['map50_95']:.4f} |" for label, m in study]
+              "clamped):", "", "| set | model | mAP50 | mAP50-95 |", "|---|---|---|---|"]
+        L += [f"| {label} | {model} | {m['map50']:.4f} | {m['map50_95']:.4f} |"
+              for label, model, m in study]
     L += ["", "**sha256:**", ""]
     for f in ("umbra-yolov8n.pt", "umbra-yolov8n.onnx", "umbra-yolov8n-int8.onnx",
               "ultralytics-test.json"):
@@ -225,6 +233,11 @@ def main() -> None:
     ap.add_argument("--weights", type=Path,
                     help="export/eval/card these weights (a continuation) instead of a train stage's")
     ap.add_argument("--lineage", help="with --weights: the card's line on where they came from")
+    ap.add_argument("--int8-weights", type=Path,
+                    help="export the int8 file from these weights (a `qat.py` fine-tune)")
+    ap.add_argument("--int8-lineage", help="with --int8-weights: the card's line on them")
+    ap.add_argument("--calib", type=Path,
+                    help="int8 calibration PNGs (default: the train set's training images)")
     ap.add_argument("--threads", type=int, default=1, help="tract threads for eval")
     a = ap.parse_args()
     stages = a.stages.split(",")
@@ -238,7 +251,8 @@ def main() -> None:
     info["command"] = ("python training/make_model.py --work DIR "
                        + " ".join(f"--{k.replace('_', '-')} {v}" for k, v in vars(a).items()
                                   if k not in ("work", "stages", "resume", "threads", "weights",
-                                               "lineage")
+                                               "lineage", "int8_weights", "int8_lineage",
+                                               "calib")
                                   and v is not None))
     info["runs"].append(" ".join(sys.argv[1:]))
     sim, lab = bins() if {"data", "eval"} & set(stages) else (None, None)
@@ -262,10 +276,22 @@ def main() -> None:
     if a.weights:
         info.update(weights=str(a.weights.resolve().parent), best=str(a.weights.resolve()),
                     lineage=a.lineage or f"`{a.weights}`")
+    if a.int8_weights:
+        info.update(int8_weights=str(a.int8_weights.resolve()),
+                    int8_lineage=a.int8_lineage or f"`{a.int8_weights}`")
+    calib = a.calib or work / "train" / "images" / "train"
+    info["calib"] = str(calib)
     if "export" in stages:
         best = Path(info.get("best") or Path(info["weights"]) / "best.pt")
         sh([sys.executable, HERE / "export.py", "--weights", best, "--out", MODELS, "--calib",
-            work / "train" / "images" / "train", "--calib-images", "256"])
+            calib, "--calib-images", "256"])
+        if info.get("int8_weights"):
+            # The int8 file from its own (quantisation-aware) weights, calibrated on the
+            # images its fine-tuning measured its ranges on; the fp32 file stays `best`'s.
+            tmp = work / "int8-export"
+            sh([sys.executable, HERE / "export.py", "--weights", info["int8_weights"], "--out",
+                tmp, "--calib", calib, "--calib-images", "256"])
+            shutil.copy(tmp / "umbra-yolov8n-int8.onnx", MODELS / "umbra-yolov8n-int8.onnx")
         shutil.copy(best, MODELS / "umbra-yolov8n.pt")
     if "eval" in stages:
         evaluate(lab, sets(a), work, a.threads)

@@ -185,15 +185,15 @@ def main() -> None:
     ap.add_argument("--strip", nargs=2, type=Path, metavar=("IN", "OUT"),
                     help="write IN as an ordinary checkpoint OUT and stop")
     a = ap.parse_args()
+    # The classes from the module `qat`, not `__main__`: the checkpoints pickle (and are
+    # compared against) those.
+    import qat
+
     if a.strip:
-        strip_checkpoint(*a.strip)
+        qat.strip_checkpoint(*a.strip)
         return
     if not (a.data and (a.init or a.resume) and a.calib):
         ap.error("--data, --init (or --resume) and --calib are needed to train")
-    # The trainer and layer classes from the module `qat`, not `__main__`, so that the
-    # checkpoints it pickles load from any script that imports `qat`.
-    import qat
-
     qat.QATTrainer.calib = calibration_tensors(a.calib, a.calib_images)
     t0 = time.time()
     w = train_mod.train(Path(a.data), a.epochs, a.batch, a.seed, a.device, a.workers, a.name,
