@@ -34,6 +34,14 @@ def png_tensor(path: Path) -> np.ndarray:
     return np.ascontiguousarray(rgb.transpose(2, 0, 1)[None].astype(np.float32) / 255.0)
 
 
+def ultralytics_onnx(weights: Path) -> Path:
+    """`weights` exported by Ultralytics as the runtime's graph before the cut: opset 17,
+    simplified, static 1x3x64x384, full head. Ultralytics writes it beside the weights."""
+    f = YOLO(str(weights)).export(format="onnx", imgsz=(64, 384), opset=17, simplify=True,
+                                  dynamic=False, batch=1, device="cpu")
+    return Path(f)
+
+
 def quantise(fp32: Path, out: Path, calib: Path, n: int) -> None:
     from onnxruntime.quantization import (CalibrationDataReader, QuantFormat, QuantType,
                                           quantize_static)
@@ -66,9 +74,7 @@ def main() -> None:
     a = ap.parse_args()
     out = Path(a.out)
     out.mkdir(parents=True, exist_ok=True)
-    model = YOLO(a.weights)
-    f = model.export(format="onnx", imgsz=(64, 384), opset=17, simplify=True, dynamic=False,
-                     batch=1, device="cpu")
+    f = ultralytics_onnx(Path(a.weights))
     fp32 = out / "umbra-yolov8n.onnx"
     if a.full_head:
         shutil.copy(f, fp32)

@@ -85,13 +85,12 @@ class QConv2d(nn.Conv2d):
 def quantised_layers(model: nn.Module):
     """(name, module, output-producing module) of every convolution the int8 export quantises."""
     for name, m in model.named_modules():
-        if ".dfl" in name or name.endswith("dfl"):
-            continue
+        if "dfl" in name:
+            continue  # the DFL is decoded in float by the runtime, not in the graph
         if isinstance(m, Conv) and isinstance(getattr(m, "bn", None), nn.BatchNorm2d):
             yield name, m, m.bn
-    for name, m in model.named_modules():
-        if type(m) is nn.Conv2d and ".dfl" not in name and not name.endswith(".conv"):
-            yield name, m, m
+        elif type(m) is nn.Conv2d and not name.endswith(".conv"):
+            yield name, m, m  # a bare convolution, not the inside of a Conv block
 
 
 def calibration_tensors(folder: Path, n: int) -> list[torch.Tensor]:
@@ -181,7 +180,9 @@ def main() -> None:
     ap.add_argument("--workers", type=int, default=2)
     ap.add_argument("--device", default="cpu")
     ap.add_argument("--name", default="qat")
-    ap.add_argument("--resume", action="store_true", help="continue runs/NAME/weights/last.pt")
+    ap.add_argument("--resume", action="store_true",
+                    help="continue runs/NAME/weights/last.pt (the ranges are measured again, "
+                    "on its weights)")
     ap.add_argument("--strip", nargs=2, type=Path, metavar=("IN", "OUT"),
                     help="write IN as an ordinary checkpoint OUT and stop")
     a = ap.parse_args()

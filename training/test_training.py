@@ -72,17 +72,14 @@ def decode_logits(lg: np.ndarray) -> np.ndarray:
 
 def test_logits_head(data: Path) -> None:
     import onnxruntime as ort
-    from ultralytics import YOLO
 
     import logits_head
-    from export import png_tensor
+    from export import png_tensor, ultralytics_onnx
 
     tmp = Path(tempfile.mkdtemp())
     # Ultralytics writes the export beside the weights: export a copy, not the shipped file.
     shutil.copy(HERE.parent / "models/yolo/umbra-yolov8n.pt", tmp / "full.pt")
-    full = Path(YOLO(str(tmp / "full.pt")).export(
-        format="onnx", imgsz=(64, 384), opset=17, simplify=True, dynamic=False, batch=1,
-        device="cpu"))
+    full = ultralytics_onnx(tmp / "full.pt")
     logits_head.cut(full, tmp / "cut.onnx")
     run = {k: ort.InferenceSession(str(f), providers=["CPUExecutionProvider"])
            for k, f in (("full", full), ("cut", tmp / "cut.onnx"))}
@@ -102,22 +99,18 @@ def test_qat_emulates_int8(data: Path, calib: int = 32) -> None:
     import torch
     from ultralytics import YOLO
 
+    import logits_head
     import qat
-    from export import png_tensor, quantise
+    from export import png_tensor, quantise, ultralytics_onnx
 
     tmp = Path(tempfile.mkdtemp())
     shutil.copy(HERE.parent / "models/yolo/umbra-yolov8n.pt", tmp / "m.pt")
     f32 = tmp / "m.onnx"
-    import logits_head
-
-    logits_head.cut(Path(YOLO(str(tmp / "m.pt")).export(
-        format="onnx", imgsz=(64, 384), opset=17, simplify=True, dynamic=False, batch=1,
-        device="cpu")), f32)
+    logits_head.cut(ultralytics_onnx(tmp / "m.pt"), f32)
     folder = data.parent / "images" / "train"
     quantise(f32, tmp / "m8.onnx", folder, calib)
     model = YOLO(str(tmp / "m.pt")).model.float().eval()
     n = qat.prepare(model, qat.calibration_tensors(folder, calib))
-    model.eval()
     run = {k: ort.InferenceSession(str(f), providers=["CPUExecutionProvider"])
            for k, f in (("fp32", f32), ("int8", tmp / "m8.onnx"))}
     emulated_off, float_off = [], []
