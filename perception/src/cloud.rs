@@ -12,6 +12,15 @@
 //!
 //! Points that are not finite are refused and counted ([`GlobalCloud::rejected`]): NaN and
 //! infinite ranges must be filtered upstream, and this is the guard if they are not.
+//!
+//! **Seen through.** Aging alone keeps a thing that was taken away in the cloud for seconds
+//! (half the points of a box are still there 13 revolutions later, enough for DBSCAN), so
+//! Method A would go on reporting it. Before aging, a revolution forgets every point its rays
+//! have passed through ([`GlobalCloud::clear_seen_through`]): the rays on both sides of the
+//! point's bearing, and the one beyond each, all returned from farther than the point by a
+//! margin. Any surface through the point, however grazing, would have stopped one of the two
+//! rays that bracket it short of that, so a wall seen at a glancing angle keeps its points; a
+//! bin with no return says nothing (dark surfaces drop out).
 
 use heapless::Deque;
 
@@ -30,6 +39,9 @@ pub struct CloudConfig {
     pub range_min_m: f32,
     /// Longest range kept, metres (the LDS-01 is specified to 3.5 m).
     pub range_max_m: f32,
+    /// A point is forgotten when the rays around its bearing all return from farther than
+    /// it by this plus 3 % of its range, metres ([`GlobalCloud::clear_seen_through`]); 0: never.
+    pub clear_margin_m: f32,
 }
 
 impl Default for CloudConfig {
@@ -38,6 +50,7 @@ impl Default for CloudConfig {
             drop_fraction: 0.05,
             range_min_m: 0.12,
             range_max_m: 3.5,
+            clear_margin_m: 0.15,
         }
     }
 }
@@ -60,13 +73,33 @@ pub struct Scan<'a> {
     pub mount: Pose2,
 }
 
+impl Scan<'_> {
+    /// The LiDAR's pose (map frame) when bin `d` was read.
+    pub fn lidar_at(&self, d: usize) -> Pose2 {
+        let n = self.ranges.len().max(1);
+        let u = (n - 1 - d.min(n - 1)) as f32 / n as f32;
+        let dtheta = crate::geometry::wrap_angle(self.end.theta - self.start.theta);
+        Pose2::new(
+            self.start.x + (self.end.x - self.start.x) * u,
+            self.start.y + (self.end.y - self.start.y) * u,
+            self.start.theta + dtheta * u,
+        )
+        .compose(&self.mount)
+    }
+}
+
 /// The cloud: a `heapless::Deque` (the bound is in the type), oldest point at the front.
 #[derive(Clone)]
 pub struct GlobalCloud {
     pts: Deque<Point2, CLOUD_CAPACITY>,
     overwritten: u64,
     rejected: u64,
+    cleared: u64,
 }
+
+/// Share of a point's range added to [`CloudConfig::clear_margin_m`] (the LDS-01's range
+/// noise is 1–3.5 % of the range).
+const CLEAR_MARGIN_FRACTION: f32 = 0.03;
 
 impl Default for GlobalCloud {
     fn default() -> Self {
@@ -80,6 +113,7 @@ impl core::fmt::Debug for GlobalCloud {
             .field("len", &self.pts.len())
             .field("overwritten", &self.overwritten)
             .field("rejected", &self.rejected)
+            .field("cleared", &self.cleared)
             .finish()
     }
 }
@@ -91,6 +125,7 @@ impl GlobalCloud {
             pts: Deque::new(),
             overwritten: 0,
             rejected: 0,
+            cleared: 0,
         }
     }
 
@@ -112,6 +147,11 @@ impl GlobalCloud {
     /// Points refused because a coordinate was not finite.
     pub fn rejected(&self) -> u64 {
         self.rejected
+    }
+
+    /// Points forgotten because a revolution's rays passed through them.
+    pub fn cleared(&self) -> u64 {
+        self.cleared
     }
 
     /// Forgets every point (counters are kept).
@@ -150,15 +190,70 @@ impl GlobalCloud {
         true
     }
 
-    /// Ages the cloud by one revolution and adds `scan`'s returns within the configured
-    /// range window; returns how many were added. Non-finite ranges are refused and counted.
+    /// Forgets the points `scan`'s rays passed through (module docs), with `margin_m` the
+    /// fixed part of the margin; returns how many went. Each point is looked at from the
+    /// LiDAR's pose at the instant its bin was read (found in two steps: the bin from the
+    /// revolution's middle, then from that bin's own instant).
+    pub fn clear_seen_through(&mut self, scan: &Scan<'_>, margin_m: f32) -> usize {
+        let n = scan.ranges.len();
+        if n < 4 || !(margin_m > 0.0) {
+            return 0;
+        }
+        let step = core::f32::consts::TAU / n as f32;
+        let at_bin = |d: usize| scan.lidar_at(d).inverse();
+        let mid = at_bin(n / 2);
+        // Bearing (in bins, 0..n) and range of `p` seen from `inv`.
+        let polar = |inv: &Pose2, p: Point2| {
+            let l = inv.transform(p);
+            let a = libm::atan2f(l.y, l.x);
+            let a = if a < 0.0 {
+                a + core::f32::consts::TAU
+            } else {
+                a
+            };
+            (a / step, l.norm())
+        };
+        let seen_through = |p: Point2| {
+            let (bins, _) = polar(&mid, p);
+            let own = at_bin((bins as usize).min(n - 1));
+            let (bins, rho) = polar(&own, p);
+            if !(bins.is_finite() && rho.is_finite()) {
+                return false;
+            }
+            let beyond = rho + margin_m + CLEAR_MARGIN_FRACTION * rho;
+            let first = libm::floorf(bins) as usize + n - 1;
+            (first..first + 4).all(|d| {
+                let r = scan.ranges[d % n];
+                r.is_finite() && r > beyond
+            })
+        };
+        let len = self.pts.len();
+        let mut cleared = 0;
+        for _ in 0..len {
+            let Some(p) = self.pts.pop_front() else {
+                break;
+            };
+            if seen_through(p) {
+                cleared += 1;
+            } else {
+                // One was just popped: room for it.
+                let _ = self.pts.push_back(p);
+            }
+        }
+        self.cleared += cleared as u64;
+        cleared
+    }
+
+    /// Forgets what `scan` saw through (if [`CloudConfig::clear_margin_m`] is above 0), ages
+    /// the cloud by one revolution and adds `scan`'s returns within the configured range
+    /// window; returns how many were added. Non-finite ranges are refused and counted.
     pub fn add_scan(&mut self, scan: &Scan<'_>, cfg: &CloudConfig) -> usize {
+        self.clear_seen_through(scan, cfg.clear_margin_m);
         self.age(cfg.drop_fraction);
         let n = scan.ranges.len();
         if n == 0 {
             return 0;
         }
-        let dtheta = crate::geometry::wrap_angle(scan.end.theta - scan.start.theta);
         let step = core::f32::consts::TAU / n as f32;
         let mut added = 0;
         for (d, &r) in scan.ranges.iter().enumerate() {
@@ -169,13 +264,7 @@ impl GlobalCloud {
             if r < cfg.range_min_m || r > cfg.range_max_m {
                 continue;
             }
-            let u = (n - 1 - d) as f32 / n as f32;
-            let pose = Pose2::new(
-                scan.start.x + (scan.end.x - scan.start.x) * u,
-                scan.start.y + (scan.end.y - scan.start.y) * u,
-                scan.start.theta + dtheta * u,
-            );
-            let lidar = pose.compose(&scan.mount);
+            let lidar = scan.lidar_at(d);
             let local = Point2::from_polar(r, d as f32 * step);
             if self.push(lidar.transform(local)) {
                 added += 1;
@@ -255,6 +344,106 @@ mod test {
         assert_eq!(added, 1);
         assert_eq!(c.rejected(), 4);
         assert!(c.age(f32::NAN) == 0 && c.len() == 1);
+    }
+
+    fn still(ranges: &[f32], at: Pose2) -> Scan<'_> {
+        Scan {
+            ranges,
+            start: at,
+            end: at,
+            mount: Pose2::IDENTITY,
+        }
+    }
+
+    /// A box 1 m ahead (bins 355..=5) in a room whose walls are 3 m away.
+    fn with_box() -> [f32; 360] {
+        let mut r = scan_of(3.0);
+        for d in (355..360).chain(0..6) {
+            r[d] = 1.0;
+        }
+        r
+    }
+
+    #[test]
+    fn a_thing_taken_away_is_forgotten_at_once() {
+        let mut c = GlobalCloud::new();
+        let cfg = CloudConfig::default();
+        let boxed = with_box();
+        for _ in 0..20 {
+            c.add_scan(&still(&boxed, Pose2::IDENTITY), &cfg);
+        }
+        let near = |c: &GlobalCloud| c.iter().filter(|p| p.norm() < 1.5).count();
+        assert!(near(&c) > 100);
+        // Taken away: the rays now reach the wall behind.
+        let empty = scan_of(3.0);
+        c.add_scan(&still(&empty, Pose2::IDENTITY), &cfg);
+        assert_eq!(near(&c), 0);
+        assert!(c.cleared() > 100);
+        // Aging alone (clearing off) keeps most of them.
+        let mut aged = GlobalCloud::new();
+        let off = CloudConfig {
+            clear_margin_m: 0.0,
+            ..cfg
+        };
+        for _ in 0..20 {
+            aged.add_scan(&still(&boxed, Pose2::IDENTITY), &off);
+        }
+        aged.add_scan(&still(&empty, Pose2::IDENTITY), &off);
+        assert!(near(&aged) > 100);
+    }
+
+    #[test]
+    fn no_return_says_nothing() {
+        let mut c = GlobalCloud::new();
+        let cfg = CloudConfig::default();
+        c.add_scan(&still(&with_box(), Pose2::IDENTITY), &cfg);
+        // A dark box: its bins return nothing. The wall beside it returns as before.
+        let mut dark = scan_of(3.0);
+        for d in (355..360).chain(0..6) {
+            dark[d] = 0.0;
+        }
+        assert_eq!(
+            c.clear_seen_through(&still(&dark, Pose2::IDENTITY), 0.15),
+            0
+        );
+    }
+
+    /// Ranges from the origin to the line y = `y` (bins whose rays meet it within 3.5 m).
+    fn wall_at(y: f32, from: Pose2) -> [f32; 360] {
+        let mut r = scan_of(0.0);
+        for (d, slot) in r.iter_mut().enumerate() {
+            let a = from.theta + (d as f32).to_radians();
+            let s = libm::sinf(a);
+            if s > 1e-3 {
+                let t = (y - from.y) / s;
+                if t <= 3.5 {
+                    *slot = t;
+                }
+            }
+        }
+        r
+    }
+
+    #[test]
+    fn a_grazing_wall_keeps_its_points() {
+        // A wall along the robot's path, 0.3 m to its left: the far rays meet it at 5°.
+        let mut c = GlobalCloud::new();
+        let cfg = CloudConfig::default();
+        let first = Pose2::IDENTITY;
+        c.add_scan(&still(&wall_at(0.3, first), first), &cfg);
+        let before = c.len();
+        assert!(before > 150);
+        // A little further on and turned by a fraction of a bin, so that every ray of the
+        // next revolution passes between the old points.
+        for k in 1..=5 {
+            let next = Pose2::new(0.013 * k as f32, 0.0, 0.0031 * k as f32);
+            let ranges = wall_at(0.3, next);
+            assert_eq!(
+                c.clear_seen_through(&still(&ranges, next), 0.15),
+                0,
+                "step {k}"
+            );
+        }
     }
 
     #[test]

@@ -27,7 +27,9 @@ pub enum View {
     Hidden,
     /// In plain view: the rays reach it (they end inside its footprint).
     Plain,
-    /// Seen empty: at least two rays cross it and every one that returned did so from beyond.
+    /// Seen empty: no ray ended in it, at least two crossed it and returned from beyond, and
+    /// no fewer than ended in front of it (a footprint partly behind something nearer is still
+    /// seen through where the rays reach it).
     Empty,
 }
 
@@ -59,7 +61,7 @@ pub fn view(centre: Point2, r: f32, lidar: &Pose2, ranges: &[f32; BINS], max_ran
             beyond += 1;
         }
     }
-    if inside == 0 && before == 0 && beyond >= 2 {
+    if inside == 0 && beyond >= 2 && beyond >= before {
         View::Empty
     } else if inside > 0 && inside >= before {
         View::Plain
@@ -104,5 +106,41 @@ pub fn doorway_view(
         (_, View::Empty) => DoorView::NoJambs,
         (View::Hidden, View::Hidden) => DoorView::Hidden,
         _ => DoorView::Open,
+    }
+}
+
+#[cfg(test)]
+mod test {
+    use super::*;
+
+    /// A footprint of radius 0.35 m 2 m straight ahead spans bins 350..=359 and 0..=10.
+    fn look(ranges: &[f32; BINS]) -> View {
+        view(Point2::new(2.0, 0.0), 0.35, &Pose2::IDENTITY, ranges, 3.5)
+    }
+
+    #[test]
+    fn a_footprint_partly_behind_something_is_seen_through_where_the_rays_reach() {
+        let mut r = [3.2; BINS];
+        assert_eq!(look(&r), View::Empty);
+        // Its right half behind a pillar 1 m away: the left half still shows it empty.
+        for d in 350..BINS {
+            r[d] = 1.0;
+        }
+        assert_eq!(look(&r), View::Empty);
+        // One ray ends in it: something is there (in plain view only with no more rays in
+        // front of it than in it).
+        r[5] = 2.1;
+        assert_eq!(look(&r), View::Hidden);
+        r[350..BINS].fill(3.2);
+        assert_eq!(look(&r), View::Plain);
+        r[350..BINS].fill(1.0);
+        // Mostly behind the pillar: too little seen to call it empty.
+        r[5] = 3.2;
+        for d in 0..8 {
+            r[d] = 1.0;
+        }
+        assert_eq!(look(&r), View::Hidden);
+        // No return at all says nothing.
+        assert_eq!(look(&[0.0; BINS]), View::Hidden);
     }
 }

@@ -49,6 +49,7 @@
 //! [method_a]                   # the geometric pipeline (docs/method-a.md)
 //! enabled = true
 //! drop_fraction = 0.05         # oldest share of the cloud dropped every revolution
+//! clear_margin_m = 0.15        # forget points the rays pass beyond by this + 3 % (0: never)
 //! eps_min_m = 0.08             # adaptive DBSCAN radius bounds
 //! eps_max_m = 0.32
 //! min_samples = 10
@@ -261,6 +262,9 @@ pub struct MethodASettings {
     pub enabled: bool,
     /// Share of the cloud dropped (oldest first) every revolution.
     pub drop_fraction: f32,
+    /// Points the rays around their bearing pass beyond by this (plus 3 % of their range)
+    /// are forgotten, m; 0: only aging forgets (`perception::cloud`).
+    pub clear_margin_m: f32,
     /// Smallest DBSCAN radius, m.
     pub eps_min_m: f32,
     /// Largest DBSCAN radius, m.
@@ -295,6 +299,7 @@ impl Default for MethodASettings {
         MethodASettings {
             enabled: true,
             drop_fraction: d.cloud.drop_fraction,
+            clear_margin_m: d.cloud.clear_margin_m,
             eps_min_m: d.dbscan.eps_min_m,
             eps_max_m: d.dbscan.eps_max_m,
             min_samples: d.dbscan.min_samples,
@@ -490,6 +495,7 @@ impl Config {
         let a = &self.method_a;
         let within = |name: &str, v: f32, lo: f32, hi: f32| within("method_a", name, v, lo, hi);
         within("drop_fraction", a.drop_fraction, 0.0, 1.0)?;
+        within("clear_margin_m", a.clear_margin_m, 0.0, 10.0)?;
         within("eps_min_m", a.eps_min_m, 0.01, 2.0)?;
         within("eps_max_m", a.eps_max_m, a.eps_min_m, 2.0)?;
         within("merge_link_m", a.merge_link_m, 0.0, 5.0)?;
