@@ -196,7 +196,7 @@ impl GlobalCloud {
     /// revolution's middle, then from that bin's own instant).
     pub fn clear_seen_through(&mut self, scan: &Scan<'_>, margin_m: f32) -> usize {
         let n = scan.ranges.len();
-        if n < 4 || !(margin_m > 0.0) {
+        if n < 4 || margin_m.is_nan() || margin_m <= 0.0 {
             return 0;
         }
         let step = core::f32::consts::TAU / n as f32;

@@ -123,9 +123,7 @@ mod test {
         let mut r = [3.2; BINS];
         assert_eq!(look(&r), View::Empty);
         // Its right half behind a pillar 1 m away: the left half still shows it empty.
-        for d in 350..BINS {
-            r[d] = 1.0;
-        }
+        r[350..BINS].fill(1.0);
         assert_eq!(look(&r), View::Empty);
         // One ray ends in it: something is there (in plain view only with no more rays in
         // front of it than in it).
@@ -136,9 +134,7 @@ mod test {
         r[350..BINS].fill(1.0);
         // Mostly behind the pillar: too little seen to call it empty.
         r[5] = 3.2;
-        for d in 0..8 {
-            r[d] = 1.0;
-        }
+        r[..8].fill(1.0);
         assert_eq!(look(&r), View::Hidden);
         // No return at all says nothing.
         assert_eq!(look(&[0.0; BINS]), View::Hidden);
