@@ -33,13 +33,28 @@ pub enum View {
     Empty,
 }
 
-/// What this revolution (`ranges`, from `lidar`) showed of a footprint of radius `r` m at
-/// `centre` (map frame); nothing beyond `max_range_m`.
-pub fn view(centre: Point2, r: f32, lidar: &Pose2, ranges: &[f32; BINS], max_range_m: f32) -> View {
+/// The returns of the bins across a disc: how many ended in front of it, in it, beyond it.
+#[derive(Debug, Clone, Copy, Default)]
+struct Across {
+    before: u32,
+    inside: u32,
+    beyond: u32,
+}
+
+/// The bins of this revolution (`ranges`, from `lidar`) across a disc of radius `r` m at
+/// `centre` (map frame), or `None` when it is out of range (beyond `max_range_m`) or the
+/// LiDAR is inside it.
+fn across(
+    centre: Point2,
+    r: f32,
+    lidar: &Pose2,
+    ranges: &[f32; BINS],
+    max_range_m: f32,
+) -> Option<Across> {
     let local = lidar.inverse().transform(centre);
     let dist = libm::sqrtf(local.x * local.x + local.y * local.y);
     if dist <= r || dist + r > max_range_m {
-        return View::Hidden;
+        return None;
     }
     let bearing = libm::atan2f(local.y, local.x).to_degrees();
     let half = libm::asinf((r / dist).min(1.0)).to_degrees();
@@ -47,26 +62,30 @@ pub fn view(centre: Point2, r: f32, lidar: &Pose2, ranges: &[f32; BINS], max_ran
         libm::ceilf(bearing - half) as i32,
         libm::floorf(bearing + half) as i32,
     );
-    let (mut beyond, mut inside, mut before) = (0, 0, 0);
+    let mut a = Across::default();
     for d in lo..=hi {
         let range = ranges[d.rem_euclid(BINS as i32) as usize];
         if range <= 0.0 || !range.is_finite() {
             continue; // no return: says nothing (dark surfaces drop out)
         }
         if range < dist - r {
-            before += 1;
+            a.before += 1;
         } else if range < dist + r {
-            inside += 1;
+            a.inside += 1;
         } else {
-            beyond += 1;
+            a.beyond += 1;
         }
     }
-    if inside == 0 && beyond >= 2 && beyond >= before {
-        View::Empty
-    } else if inside > 0 && inside >= before {
-        View::Plain
-    } else {
-        View::Hidden
+    Some(a)
+}
+
+/// What this revolution (`ranges`, from `lidar`) showed of a footprint of radius `r` m at
+/// `centre` (map frame); nothing beyond `max_range_m`.
+pub fn view(centre: Point2, r: f32, lidar: &Pose2, ranges: &[f32; BINS], max_range_m: f32) -> View {
+    match across(centre, r, lidar, ranges, max_range_m) {
+        Some(a) if a.inside == 0 && a.beyond >= 2 && a.beyond >= a.before => View::Empty,
+        Some(a) if a.inside > 0 && a.inside >= a.before => View::Plain,
+        _ => View::Hidden,
     }
 }
 
@@ -100,11 +119,16 @@ pub fn doorway_view(
     max_range_m: f32,
 ) -> DoorView {
     let middle = view(centre, DOOR_MIDDLE_M, lidar, ranges, max_range_m);
-    let whole = view(centre, half_width + DOOR_JAMB_M, lidar, ranges, max_range_m);
-    match (middle, whole) {
-        (View::Plain, _) => DoorView::Closed,
-        (_, View::Empty) => DoorView::NoJambs,
-        (View::Hidden, View::Hidden) => DoorView::Hidden,
+    let whole = across(centre, half_width + DOOR_JAMB_M, lidar, ranges, max_range_m);
+    // No jambs only where every ray that reached the jambs' places went on: a jamb behind
+    // something nearer is not seen missing (unlike a piece of furniture's footprint, which
+    // the rays that do reach it show empty).
+    let no_jambs = whole.is_some_and(|a| a.inside == 0 && a.before == 0 && a.beyond >= 2);
+    let whole_hidden = whole.is_none_or(|a| !(a.inside > 0 && a.inside >= a.before));
+    match middle {
+        View::Plain => DoorView::Closed,
+        _ if no_jambs => DoorView::NoJambs,
+        View::Hidden if whole_hidden => DoorView::Hidden,
         _ => DoorView::Open,
     }
 }
@@ -138,5 +162,20 @@ mod test {
         assert_eq!(look(&r), View::Hidden);
         // No return at all says nothing.
         assert_eq!(look(&[0.0; BINS]), View::Hidden);
+    }
+
+    #[test]
+    fn a_jamb_behind_something_nearer_is_not_seen_missing() {
+        // A doorway 0.9 m wide 2 m ahead; the rays through it return from 3.2 m.
+        let look =
+            |r: &[f32; BINS]| doorway_view(Point2::new(2.0, 0.0), 0.45, &Pose2::IDENTITY, r, 3.5);
+        let mut r = [3.2; BINS];
+        assert_eq!(look(&r), DoorView::NoJambs, "open floor, no jambs");
+        // One jamb's bins behind a chair 1 m away: the doorway is not shown to be open floor.
+        r[8..20].fill(1.0);
+        assert_eq!(look(&r), DoorView::Open);
+        // Something in its middle: shut.
+        r[0] = 2.0;
+        assert_eq!(look(&r), DoorView::Closed);
     }
 }
