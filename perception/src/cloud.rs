@@ -192,37 +192,61 @@ impl GlobalCloud {
 
     /// Forgets the points `scan`'s rays passed through (module docs), with `margin_m` the
     /// fixed part of the margin; returns how many went. Each point is looked at from the
-    /// LiDAR's pose at the instant its bin was read (found in two steps: the bin from the
-    /// revolution's middle, then from that bin's own instant).
+    /// LiDAR's pose at the instant its bin was read, found in two steps: the bin from the
+    /// revolution's middle, then from that bin's own instant. The second step moves the view
+    /// by the LiDAR's motion between the two instants, taken as linear in time within one
+    /// revolution (as `add_scan` de-skews), so each point costs two `atan2`, one `sincos` of
+    /// that small turn and one square root, not a pose composition.
     pub fn clear_seen_through(&mut self, scan: &Scan<'_>, margin_m: f32) -> usize {
         let n = scan.ranges.len();
         if n < 4 || margin_m.is_nan() || margin_m <= 0.0 {
             return 0;
         }
         let step = core::f32::consts::TAU / n as f32;
-        let at_bin = |d: usize| scan.lidar_at(d).inverse();
-        let mid = at_bin(n / 2);
-        // Bearing (in bins, 0..n) and range of `p` seen from `inv`.
-        let polar = |inv: &Pose2, p: Point2| {
-            let l = inv.transform(p);
-            let a = libm::atan2f(l.y, l.x);
+        // Bin `d` is read at u = (n − 1 − d) / n of the revolution.
+        let u_of = |d: usize| (n - 1 - d.min(n - 1)) as f32 / n as f32;
+        let (d_mid, d_first, d_last) = (n / 2, n - 1, 0);
+        let mid = scan.lidar_at(d_mid).inverse();
+        // The LiDAR's position at the revolution's first and last ray, in the middle's frame.
+        let xy = |q: Pose2| Point2::new(q.x, q.y);
+        let first = mid.transform(xy(scan.lidar_at(d_first)));
+        let last = mid.transform(xy(scan.lidar_at(d_last)));
+        let (u_mid, u_last) = (u_of(d_mid), u_of(d_last));
+        let dtheta = crate::geometry::wrap_angle(scan.end.theta - scan.start.theta);
+        let bins_of = |x: f32, y: f32| {
+            let a = libm::atan2f(y, x);
             let a = if a < 0.0 {
                 a + core::f32::consts::TAU
             } else {
                 a
             };
-            (a / step, l.norm())
+            a / step
         };
         let seen_through = |p: Point2| {
-            let (bins, _) = polar(&mid, p);
-            let own = at_bin((bins as usize).min(n - 1));
-            let (bins, rho) = polar(&own, p);
+            let l = mid.transform(p);
+            let d = bins_of(l.x, l.y);
+            if !d.is_finite() {
+                return false;
+            }
+            // Where the LiDAR was, and how far it had turned, when bin `d` was read.
+            let u = u_of(d as usize);
+            let k = u / u_last;
+            let at = Point2::new(
+                first.x + (last.x - first.x) * k,
+                first.y + (last.y - first.y) * k,
+            );
+            let turn = dtheta * (u - u_mid);
+            let (s, c) = (libm::sinf(turn), libm::cosf(turn));
+            let (vx, vy) = (l.x - at.x, l.y - at.y);
+            let (x, y) = (c * vx + s * vy, c * vy - s * vx);
+            let bins = bins_of(x, y);
+            let rho = libm::sqrtf(x * x + y * y);
             if !(bins.is_finite() && rho.is_finite()) {
                 return false;
             }
             let beyond = rho + margin_m + CLEAR_MARGIN_FRACTION * rho;
-            let first = libm::floorf(bins) as usize + n - 1;
-            (first..first + 4).all(|d| {
+            let first_bin = libm::floorf(bins) as usize + n - 1;
+            (first_bin..first_bin + 4).all(|d| {
                 let r = scan.ranges[d % n];
                 r.is_finite() && r > beyond
             })
@@ -390,6 +414,90 @@ mod test {
         }
         aged.add_scan(&still(&empty, Pose2::IDENTITY), &off);
         assert!(near(&aged) > 100);
+    }
+
+    #[test]
+    fn a_turning_robot_clears_only_what_is_gone() {
+        // The robot turns 0.6 rad and drifts 5 cm during each revolution: a box 1 m ahead (in
+        // the map) and walls 3 m away, scanned de-skewed.
+        let cfg = CloudConfig::default();
+        let mount = Pose2::new(-0.032, 0.0, 0.0);
+        let rev = |k: usize| {
+            let a = 0.6 * k as f32;
+            (
+                Pose2::new(0.05 * k as f32, 0.0, a),
+                Pose2::new(0.05 * (k + 1) as f32, 0.0, a + 0.6),
+            )
+        };
+        // Ranges of a revolution from `start` to `end`: the box (a disc of 0.15 m at (1, 0))
+        // if `with_box`, else the walls.
+        let scan_at = |start: Pose2, end: Pose2, with_box: bool| {
+            let mut r = [3.0f32; 360];
+            for (d, slot) in r.iter_mut().enumerate() {
+                let lidar = Scan {
+                    ranges: &[0.0; 360],
+                    start,
+                    end,
+                    mount,
+                }
+                .lidar_at(d);
+                let a = lidar.theta + (d as f32).to_radians();
+                let (dx, dy) = (1.0 - lidar.x, -lidar.y);
+                let along = dx * libm::cosf(a) + dy * libm::sinf(a);
+                let off = (dx * libm::sinf(a) - dy * libm::cosf(a)).abs();
+                if with_box && along > 0.0 && off < 0.15 {
+                    *slot = along - libm::sqrtf(0.15 * 0.15 - off * off);
+                }
+            }
+            r
+        };
+        let mut c = GlobalCloud::new();
+        for k in 0..8 {
+            let (s, e) = rev(k);
+            let r = scan_at(s, e, true);
+            c.add_scan(
+                &Scan {
+                    ranges: &r,
+                    start: s,
+                    end: e,
+                    mount,
+                },
+                &cfg,
+            );
+        }
+        let near = |c: &GlobalCloud| {
+            c.iter()
+                .filter(|p| p.distance(Point2::new(1.0, 0.0)) < 0.3)
+                .count()
+        };
+        let before = near(&c);
+        assert!(before > 20, "{before}");
+        // Still there: nothing of it goes, however the robot turns.
+        let (s, e) = rev(8);
+        let r = scan_at(s, e, true);
+        let mut kept = c.clone();
+        kept.clear_seen_through(
+            &Scan {
+                ranges: &r,
+                start: s,
+                end: e,
+                mount,
+            },
+            cfg.clear_margin_m,
+        );
+        assert_eq!(near(&kept), before);
+        // Gone: all of it goes in one revolution.
+        let r = scan_at(s, e, false);
+        c.clear_seen_through(
+            &Scan {
+                ranges: &r,
+                start: s,
+                end: e,
+                mount,
+            },
+            cfg.clear_margin_m,
+        );
+        assert_eq!(near(&c), 0);
     }
 
     #[test]
