@@ -474,29 +474,22 @@ mod test {
         assert!(before > 20, "{before}");
         // Still there: nothing of it goes, however the robot turns.
         let (s, e) = rev(8);
-        let r = scan_at(s, e, true);
-        let mut kept = c.clone();
-        kept.clear_seen_through(
-            &Scan {
+        // Clears `cloud` with the ninth revolution, the box there or not.
+        let clear = |cloud: &mut GlobalCloud, with_box: bool| {
+            let r = scan_at(s, e, with_box);
+            let scan = Scan {
                 ranges: &r,
                 start: s,
                 end: e,
                 mount,
-            },
-            cfg.clear_margin_m,
-        );
+            };
+            cloud.clear_seen_through(&scan, cfg.clear_margin_m)
+        };
+        let mut kept = c.clone();
+        clear(&mut kept, true);
         assert_eq!(near(&kept), before);
         // Gone: all of it goes in one revolution.
-        let r = scan_at(s, e, false);
-        c.clear_seen_through(
-            &Scan {
-                ranges: &r,
-                start: s,
-                end: e,
-                mount,
-            },
-            cfg.clear_margin_m,
-        );
+        clear(&mut c, false);
         assert_eq!(near(&c), 0);
     }
 
