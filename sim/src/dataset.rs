@@ -343,7 +343,7 @@ fn scene_json(i: usize, s: &Scenario, split: Split) -> Value {
             "footprint": d.footprint.iter().map(|p| pt(*p)).collect::<Vec<_>>()})).collect::<Vec<_>>(),
         "clutter": w.clutter.iter().enumerate().map(|(n, c)| json!({
             "id": n, "kind": c.kind, "centre": pt(c.centre)})).collect::<Vec<_>>(),
-        "hit_codes": "-1 no return, 0 wall, 1+n furniture n, 10000+n door frame n, 20000+n clutter n",
+        "hit_codes": "-1 no return, 0 wall, 1+n furniture n, 10000+n door frame n, 20000+n clutter n, 30000+n walking person n",
         "frame": "world; poses in method_a and truth.jsonl are in the map frame = robot_start",
     })
 }

@@ -61,7 +61,7 @@ impl PixelBox {
 }
 
 /// Integer code of what a reading hit: −1 nothing returned, 0 wall, `1 + n` furniture `n`,
-/// `10_000 + n` door frame `n`, `20_000 + n` clutter `n`. A reading that hit something but did
+/// `10_000 + n` door frame `n`, `20_000 + n` clutter `n`, `30_000 + n` walking person `n`. A reading that hit something but did
 /// not return (a dropout) is −1: the code says what the sensor *reported*.
 pub fn hit_code(frame: &Frame, d: usize) -> i32 {
     let r = &frame.readings[d % SCAN_COLUMNS];
@@ -74,6 +74,7 @@ pub fn hit_code(frame: &Frame, d: usize) -> i32 {
         Some(Surface::Object(n)) => 1 + i32::from(n),
         Some(Surface::DoorFrame(n)) => 10_000 + i32::from(n),
         Some(Surface::Clutter(n)) => 20_000 + i32::from(n),
+        Some(Surface::Person(n)) => 30_000 + i32::from(n),
     }
 }
 

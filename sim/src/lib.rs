@@ -11,6 +11,7 @@
 //! | [`robot`]     | differential drive (Burger constants), slip, encoders, motion scripts |
 //! | [`compass`]   | magnetometer: earth field, hard iron, noise, local disturbances       |
 //! | [`lds01`]     | LDS-01 reading model and the packet byte source                       |
+//! | [`people`]    | people walking through a scenario: paths, stance-and-swing gait, giving way |
 //! | [`scenario`]  | world + robot + sensors stepped one revolution (frame) at a time      |
 //! | [`labels`]    | Method B boxes from footprints, per-reading labels                    |
 //! | `dataset`     | dataset writers: YOLO layout, Method A labels, replay recordings (feature `tools`) |
@@ -28,6 +29,7 @@ pub mod dataset;
 pub mod labels;
 pub mod lds01;
 pub mod noise;
+pub mod people;
 #[cfg(feature = "tools")]
 pub mod picture;
 #[cfg(feature = "pty")]

@@ -146,7 +146,7 @@ pub fn write_png(
             Surface::Wall => [0, 0, 0],
             Surface::DoorFrame(_) => class_colour(ObjectClass::DoorFrame),
             Surface::Object(n) => class_colour(world.objects[usize::from(n)].class),
-            Surface::Clutter(_) => [128, 128, 128],
+            Surface::Clutter(_) | Surface::Person(_) => [128, 128, 128],
         };
         match p.shape {
             Shape::Segment { a, b } => cv.line(a, b, colour, 3),

@@ -14,8 +14,9 @@ use rand_chacha::ChaCha8Rng;
 
 use crate::compass::{Compass, CompassConfig};
 use crate::lds01::{LIDAR_MOUNT, Lds01SimConfig, LidarModel};
+use crate::people::{ROBOT_RADIUS_M, Walker};
 use crate::robot::{Robot, RobotConfig};
-use crate::world::{Surface, World, WorldConfig};
+use crate::world::{Shape, Surface, World, WorldConfig};
 
 /// Everything a scenario needs besides its seed.
 #[derive(Debug, Clone, PartialEq, Default)]
@@ -72,6 +73,8 @@ pub struct Frame {
     pub readings: [SimReading; READINGS_PER_REV],
     /// The 60 packets as sent.
     pub packets: [Repr; PACKETS_PER_REV],
+    /// Where each walking person (midpoint of the legs, world frame) was at the middle reading.
+    pub people_mid: Vec<Point2>,
 }
 
 impl Default for Frame {
@@ -85,6 +88,7 @@ impl Default for Frame {
             pose_end: Pose2::IDENTITY,
             readings: [SimReading::default(); READINGS_PER_REV],
             packets: [Repr::default(); PACKETS_PER_REV],
+            people_mid: Vec::new(),
         }
     }
 }
@@ -134,6 +138,9 @@ pub struct Scenario {
     pub robot: Robot,
     /// The compass.
     pub compass: Compass,
+    /// People walking through the world (none unless added; [`Surface::Person`] is an index
+    /// into this).
+    pub people: Vec<Walker>,
     lidar: LidarModel,
     start_pose: Pose2,
     odom_period: f64,
@@ -166,6 +173,7 @@ impl Scenario {
             world,
             robot,
             compass,
+            people: Vec::new(),
             lidar,
             odom_period: if cfg.odom_hz > 0.0 {
                 1.0 / f64::from(cfg.odom_hz)
@@ -223,19 +231,24 @@ impl Scenario {
                     frame.pose_start = self.robot.pose;
                 } else if i == READINGS_PER_REV / 2 {
                     frame.pose_mid = self.robot.pose;
+                    frame.people_mid.clear();
+                    frame
+                        .people_mid
+                        .extend(self.people.iter().map(Walker::centre));
                 }
                 let angle = lidar.theta + (d as f32).to_radians();
+                let o = Point2::new(lidar.x, lidar.y);
                 let hit = self
                     .world
-                    .raycast(Point2::new(lidar.x, lidar.y), angle, 6.0);
-                let (r, surface, reading) = match hit {
-                    Some((t, idx, cos)) => {
+                    .raycast(o, angle, MAX_RANGE_M)
+                    .map(|(t, idx, cos)| {
                         let prim = &self.world.prims[idx];
-                        (
-                            t,
-                            Some(prim.surface),
-                            self.lidar.reading(t, cos, prim.reflectivity),
-                        )
+                        (t, cos, prim.surface, prim.reflectivity)
+                    });
+                let hit = self.nearer_person(o, angle, hit);
+                let (r, surface, reading) = match hit {
+                    Some((t, cos, surface, refl)) => {
+                        (t, Some(surface), self.lidar.reading(t, cos, refl))
                     }
                     None => (0.0, None, self.lidar.miss()),
                 };
@@ -246,6 +259,9 @@ impl Scenario {
                     true_range_m: r,
                 };
                 self.robot.step(sub);
+                for w in &mut self.people {
+                    w.step(sub, o);
+                }
                 while self.robot.time_s() >= self.next_odom {
                     let (l, r) = self.robot.ticks();
                     odom.push(OdomSample {
@@ -266,13 +282,47 @@ impl Scenario {
         }
         frame.pose_end = self.robot.pose;
     }
+
+    /// `hit` (distance, cosine of incidence, surface, reflectivity), or a walking person's leg
+    /// if one is nearer along the ray.
+    fn nearer_person(
+        &self,
+        o: Point2,
+        angle: f32,
+        hit: Option<(f32, f32, Surface, f32)>,
+    ) -> Option<(f32, f32, Surface, f32)> {
+        let (s, c) = angle.sin_cos();
+        let d = Point2::new(c, s);
+        let mut best = hit;
+        for (k, w) in self.people.iter().enumerate() {
+            for leg in w.leg_shapes() {
+                let Shape::Circle { c, .. } = leg else {
+                    continue;
+                };
+                if c.distance(o) < ROBOT_RADIUS_M {
+                    continue; // stepping round the robot
+                }
+                if let Some((t, cos)) = leg.intersect(o, d)
+                    && t <= MAX_RANGE_M
+                    && best.is_none_or(|b| t < b.0)
+                {
+                    best = Some((t, cos, Surface::Person(k as u16), w.reflectivity));
+                }
+            }
+        }
+        best
+    }
 }
+
+/// Farthest a simulated ray looks, m (beyond every LiDAR model's range).
+const MAX_RANGE_M: f32 = 6.0;
 
 #[cfg(test)]
 mod test {
     use super::*;
     use drivers::lds01::{Lds01Config, Lds01Stream};
     use drivers::lidar::RevolutionStream as _;
+    use rand::SeedableRng;
 
     #[test]
     fn frames_decode_through_the_real_driver() {
@@ -301,6 +351,47 @@ mod test {
         );
         // 20 Hz odometry over ~2 s.
         assert!((38..=42).contains(&odom.len()), "{} samples", odom.len());
+    }
+
+    #[test]
+    fn a_walking_person_is_seen_where_it_walks() {
+        let mut s = Scenario::new(9, &ScenarioConfig::standard());
+        let mut rng = ChaCha8Rng::seed_from_u64(1);
+        let start = s.robot.pose;
+        let w = (0..20)
+            .find_map(|_| Walker::draw(&s.world, &mut rng, Point2::new(start.x, start.y)))
+            .expect("a walker fits");
+        s.people.push(w);
+        let mut f = Frame::default();
+        let mut odom = Vec::new();
+        let mut seen = Vec::new();
+        for _ in 0..25 {
+            s.next_frame(&mut f, &mut odom);
+            let legs: Vec<Point2> = (0..READINGS_PER_REV)
+                .filter(|&d| f.readings[d].hit == Some(Surface::Person(0)))
+                .map(|d| {
+                    let l = f.pose_mid.compose(&LIDAR_MOUNT);
+                    let a = l.theta + (d as f32).to_radians();
+                    let r = f.readings[d].true_range_m;
+                    Point2::new(l.x + r * a.cos(), l.y + r * a.sin())
+                })
+                .collect();
+            if let (Some(p), [mid]) = (legs.first(), f.people_mid.as_slice()) {
+                // Every return on the person lies on its legs: within a stride of its middle.
+                assert!(
+                    legs.iter().all(|q| q.distance(*mid) < 0.6),
+                    "{p:?} vs {mid:?}"
+                );
+                seen.push(*mid);
+            }
+        }
+        assert!(
+            seen.len() >= 5,
+            "the person was seen in {} frames",
+            seen.len()
+        );
+        let walked = seen[0].distance(seen[seen.len() - 1]);
+        assert!(walked > 0.3, "it moved {walked} m");
     }
 
     #[test]

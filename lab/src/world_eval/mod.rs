@@ -375,6 +375,13 @@ pub fn report(outcomes: &[Outcome]) -> String {
                 String::new()
             }
         );
+        for (name, t) in o.runs.iter().filter(|(_, t)| !t.people_reports.is_empty()) {
+            let _ = writeln!(
+                s,
+                "    on people in {name}: {}",
+                t.people_reports.join("; ")
+            );
+        }
     }
     s
 }

@@ -189,6 +189,9 @@ pub struct Tally {
     /// `people` entries with no walking person within reach.
     #[serde(default)]
     pub people_phantoms: u32,
+    /// The reports on walking people, one line each (frame, id, class, source), for reading.
+    #[serde(skip)]
+    pub people_reports: Vec<String>,
 }
 
 /// Class names of the tally's per-class arrays.
@@ -295,6 +298,13 @@ pub fn score_run(truth: &RunTruth, lines: &[Line], tally: &mut Tally) {
                             }
                             if main && people.iter().any(|p| p.at.distance(o.at) <= PERSON_M) {
                                 tally.people_as_furniture += 1;
+                                tally.people_reports.push(format!(
+                                    "frame {}: id {} {} ({})",
+                                    fi,
+                                    o.id,
+                                    c.map_or("?", ObjectClass::as_str),
+                                    ["A", "B", "AB"][o.source.min(2)]
+                                ));
                             }
                         } else if main && !near.any(|f| Some(f.class) == c) {
                             tally.wrong_class += 1;
@@ -534,6 +544,7 @@ impl Tally {
             phantoms_where
         );
         self.move_gone_s.extend_from_slice(&o.move_gone_s);
+        self.people_reports.extend_from_slice(&o.people_reports);
     }
 
     /// IDF1 = 2·IDTP / (GT + reported).

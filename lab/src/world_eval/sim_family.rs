@@ -8,17 +8,21 @@ use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use sim::dataset::{scenario_config, scenario_seed};
 use sim::lds01::LIDAR_MOUNT;
+use sim::people::Walker;
 use sim::scenario::{Frame, Scenario};
 use sim::world::grid::Grid;
 use sim::world::{ObjectTruth, Prim, RoomKind, Shape, Surface, World, WorldConfig};
 
 use crate::annex::GeneratedRun;
 use crate::annex::sensor::passes_through;
-use crate::run_truth::{Door, FrameTruth, Furniture, Move, RunTruth, VISIBLE_RETURNS};
+use crate::run_truth::{Door, FrameTruth, Furniture, Move, Person, RunTruth, VISIBLE_RETURNS};
 
 /// Salt of the move's own random stream, so a run's world, robot and LiDAR are the same
 /// whether or not a piece is moved in it.
 const MOVE_SALT: u64 = 0x4D0F_E5A1_7C3B_9D21;
+
+/// Salt of the people's own random stream (like [`MOVE_SALT`]).
+const PEOPLE_SALT: u64 = 0x9E0F_1E5B_2A47_C3D8;
 
 /// Shortest distance a moved piece is carried, m: farther than the world model's gate, so its
 /// old place is left empty rather than the piece nudged.
@@ -130,7 +134,9 @@ fn rays_through(frame: &Frame, footprint: &[Point2]) -> usize {
 }
 
 /// Simulator run `i` of the evaluation seed `seed`: `seconds` long (even runs turn in place,
-/// odd runs tour, as the dataset's scenarios do), all three room kinds, clutter; a share
+/// odd runs tour, as the dataset's scenarios do), all three room kinds, clutter, 0–2 people
+/// walking (`sim::people`, drawn from their own salted stream, so the room, robot and LiDAR
+/// are the same with or without them), one piece moved in half the runs; a share
 /// `varied` of the worlds drawn varied (`WorldConfig::varied`, then with up to 6 clutter
 /// items as the training data has them).
 pub fn generate(seed: u64, i: usize, seconds: f64, varied: f64) -> GeneratedRun {
@@ -147,6 +153,13 @@ pub fn generate(seed: u64, i: usize, seconds: f64, varied: f64) -> GeneratedRun 
     let n = (seconds * 5.0) as usize;
     let n_obj = s.world.objects.len();
     let planned = plan_move(&s.world, run_seed, n);
+    let start = s.robot_start_pose();
+    let mut people_rng = ChaCha8Rng::seed_from_u64(run_seed ^ PEOPLE_SALT);
+    for _ in 0..people_rng.random_range(0..=2) {
+        if let Some(w) = Walker::draw(&s.world, &mut people_rng, Point2::new(start.x, start.y)) {
+            s.people.push(w);
+        }
+    }
     let old_footprint = planned.as_ref().map(|m| s.world.objects[m.piece].footprint);
     let mut seen_empty = None;
     let mut returns = vec![0u32; n_obj + 1];
@@ -191,13 +204,28 @@ pub fn generate(seed: u64, i: usize, seconds: f64, varied: f64) -> GeneratedRun 
         }
         frames.push(FrameTruth {
             t: frame.t_start_s,
-            people: Vec::new(),
+            people: frame
+                .people_mid
+                .iter()
+                .enumerate()
+                .map(|(id, &at)| Person {
+                    id,
+                    at: to_map.transform(at),
+                    returns: frame
+                        .readings
+                        .iter()
+                        .filter(|r| {
+                            r.raw.range_mm != 0 && r.hit == Some(Surface::Person(id as u16))
+                        })
+                        .count() as u32,
+                })
+                .collect(),
         });
     }
     let w = &s.world;
     let truth = RunTruth {
         name: format!(
-            "sim {i}: {}, {}, {} piece(s), {} door(s){}",
+            "sim {i}: {}, {}, {} piece(s), {} door(s), {} walker(s){}",
             w.kind.name(),
             if i.is_multiple_of(2) {
                 "turning in place"
@@ -206,6 +234,7 @@ pub fn generate(seed: u64, i: usize, seconds: f64, varied: f64) -> GeneratedRun 
             },
             n_obj,
             w.doors.len(),
+            s.people.len(),
             match &planned {
                 Some(m) if m.to.is_some() => ", one piece moved",
                 Some(_) => ", one piece taken away",

@@ -46,6 +46,8 @@ pub enum Surface {
     Object(u16),
     /// Clutter item `n` (index into [`World::clutter`]): none of the classes.
     Clutter(u16),
+    /// A leg of walking person `n` (index into the scenario's people; `crate::people`).
+    Person(u16),
 }
 
 /// A ray-castable primitive.
