@@ -237,14 +237,12 @@ mod test {
             w.step(0.01, far);
             let now = w.legs();
             // Each tick, one of the legs stays put (the planted one), and nothing jumps.
-            let still = (0..2).any(|k| (0..2).any(|m| now[k].distance(prev[m]) < 1e-4));
+            let still = now.iter().any(|a| prev.iter().any(|b| a.distance(*b) < 1e-4));
             if !still {
                 planted_moves += 1;
             }
-            for k in 0..2 {
-                let moved = (0..2)
-                    .map(|m| now[k].distance(prev[m]))
-                    .fold(f32::MAX, f32::min);
+            for a in &now {
+                let moved = prev.iter().map(|b| a.distance(*b)).fold(f32::MAX, f32::min);
                 assert!(moved < 0.05, "a leg jumped {moved} m");
             }
             prev = now;
