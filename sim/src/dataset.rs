@@ -65,6 +65,8 @@ pub struct DatasetConfig {
     /// Put every scenario in the test split (a second test set, e.g. of room kinds a model
     /// was not trained on).
     pub test_only: bool,
+    /// People walking through each scenario: 0 to this many (`crate::people`), never labelled.
+    pub people: usize,
 }
 
 impl Default for DatasetConfig {
@@ -80,6 +82,7 @@ impl Default for DatasetConfig {
             recordings: true,
             pictures: 3,
             test_only: false,
+            people: 0,
         }
     }
 }
@@ -176,6 +179,9 @@ pub fn simulate(
 ) -> Scenario {
     let sc = scenario_config(i, &cfg.world);
     let mut scenario = Scenario::new(scenario_seed(cfg.seed, i), &sc);
+    if cfg.people > 0 {
+        crate::people::add_people(&mut scenario, scenario_seed(cfg.seed, i), cfg.people);
+    }
     let mut ring: [Box<Frame>; 3] = Default::default();
     let mut ranges = [[0.0f32; 360]; 3];
     let mut raster = vec![0u8; RASTER_LEN];
@@ -578,6 +584,37 @@ fn scenario_to_disk(
 #[cfg(test)]
 mod test {
     use super::*;
+
+    #[test]
+    fn people_walk_through_a_dataset_unlabelled() {
+        let cfg = |people| DatasetConfig {
+            scenarios: 6,
+            frames: 10,
+            seed: 3,
+            people,
+            ..DatasetConfig::default()
+        };
+        let (mut on_people, mut boxes) = (0usize, [0usize; 2]);
+        for (k, people) in [0, 2].into_iter().enumerate() {
+            for i in 0..6 {
+                simulate(
+                    i,
+                    &cfg(people),
+                    |_, f, _| {
+                        on_people += (0..360).filter(|&d| hit_code(f, d) >= 30_000).count();
+                    },
+                    |_, s| boxes[k] += s.boxes.len(),
+                );
+            }
+            if people == 0 {
+                assert_eq!(on_people, 0);
+            }
+        }
+        // People were seen, and no box was drawn for them (legs hide some furniture, so
+        // there may be fewer, never more).
+        assert!(on_people > 0, "no return on a person");
+        assert!(boxes[1] <= boxes[0], "{boxes:?}");
+    }
 
     #[test]
     fn splits_are_by_scenario_and_sized() {

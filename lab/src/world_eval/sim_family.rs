@@ -8,7 +8,7 @@ use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use sim::dataset::{scenario_config, scenario_seed};
 use sim::lds01::LIDAR_MOUNT;
-use sim::people::Walker;
+use sim::people::add_people;
 use sim::scenario::{Frame, Scenario};
 use sim::world::grid::Grid;
 use sim::world::{ObjectTruth, Prim, RoomKind, Shape, Surface, World, WorldConfig};
@@ -20,9 +20,6 @@ use crate::run_truth::{Door, FrameTruth, Furniture, Move, Person, RunTruth, VISI
 /// Salt of the move's own random stream, so a run's world, robot and LiDAR are the same
 /// whether or not a piece is moved in it.
 const MOVE_SALT: u64 = 0x4D0F_E5A1_7C3B_9D21;
-
-/// Salt of the people's own random stream (like [`MOVE_SALT`]).
-const PEOPLE_SALT: u64 = 0x9E0F_1E5B_2A47_C3D8;
 
 /// Shortest distance a moved piece is carried, m: farther than the world model's gate, so its
 /// old place is left empty rather than the piece nudged.
@@ -153,13 +150,7 @@ pub fn generate(seed: u64, i: usize, seconds: f64, varied: f64) -> GeneratedRun 
     let n = (seconds * 5.0) as usize;
     let n_obj = s.world.objects.len();
     let planned = plan_move(&s.world, run_seed, n);
-    let start = s.robot_start_pose();
-    let mut people_rng = ChaCha8Rng::seed_from_u64(run_seed ^ PEOPLE_SALT);
-    for _ in 0..people_rng.random_range(0..=2) {
-        if let Some(w) = Walker::draw(&s.world, &mut people_rng, Point2::new(start.x, start.y)) {
-            s.people.push(w);
-        }
-    }
+    add_people(&mut s, run_seed, 2);
     let old_footprint = planned.as_ref().map(|m| s.world.objects[m.piece].footprint);
     let mut seen_empty = None;
     let mut returns = vec![0u32; n_obj + 1];

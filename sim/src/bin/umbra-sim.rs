@@ -79,6 +79,10 @@ enum Command {
         /// Every scenario in the test split (a second test set from other room kinds).
         #[arg(long)]
         test_only: bool,
+        /// People walking through each scenario, 0 to N (never labelled: what Method B must
+        /// not take for furniture).
+        #[arg(long, default_value_t = 0)]
+        people: usize,
     },
     /// Labelled frames per second, rasters and labels in memory.
     Speed {
@@ -166,6 +170,7 @@ fn run(command: Command) -> Result<(), String> {
             no_recordings,
             pictures,
             test_only,
+            people,
         } => {
             let cfg = DatasetConfig {
                 scenarios,
@@ -182,6 +187,7 @@ fn run(command: Command) -> Result<(), String> {
                 recordings: !no_recordings,
                 pictures,
                 test_only,
+                people,
                 ..DatasetConfig::default()
             };
             let bar = ProgressBar::new((scenarios * frames) as u64);
