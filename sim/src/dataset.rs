@@ -180,7 +180,7 @@ pub fn simulate(
     let sc = scenario_config(i, &cfg.world);
     let mut scenario = Scenario::new(scenario_seed(cfg.seed, i), &sc);
     if cfg.people > 0 {
-        crate::people::add_people(&mut scenario, scenario_seed(cfg.seed, i), cfg.people);
+        scenario.add_people(scenario_seed(cfg.seed, i), cfg.people);
     }
     let mut ring: [Box<Frame>; 3] = Default::default();
     let mut ranges = [[0.0f32; 360]; 3];

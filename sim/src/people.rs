@@ -8,10 +8,8 @@
 //! these people is still judged on people it was not tuned on.
 
 use perception::geometry::Point2;
-use rand::{Rng, SeedableRng};
-use rand_chacha::ChaCha8Rng;
+use rand::Rng;
 
-use crate::scenario::Scenario;
 use crate::world::{Shape, World};
 
 /// Half the distance between a person's feet across the walk, m.
@@ -202,24 +200,6 @@ impl Walker {
     }
 }
 
-/// Salt of the people's own random stream, so a scenario's world, robot and LiDAR are the
-/// same with or without them.
-const PEOPLE_SALT: u64 = 0x9E0F_1E5B_2A47_C3D8;
-
-/// Walks 0 to `max` people (uniformly) through `scenario`, drawn from `seed`'s own salted
-/// stream and kept clear of the robot's start ([`Walker::draw`]). Returns how many.
-pub fn add_people(scenario: &mut Scenario, seed: u64, max: usize) -> usize {
-    let start = scenario.robot_start_pose();
-    let clear = Point2::new(start.x, start.y);
-    let mut rng = ChaCha8Rng::seed_from_u64(seed ^ PEOPLE_SALT);
-    for _ in 0..rng.random_range(0..=max) {
-        if let Some(w) = Walker::draw(&scenario.world, &mut rng, clear) {
-            scenario.people.push(w);
-        }
-    }
-    scenario.people.len()
-}
-
 /// Whether the straight walk `a`→`b` keeps [`PATH_CLEARANCE_M`] from walls and furniture and
 /// [`GIVE_WAY_M`] from `keep_clear`.
 fn path_free(world: &World, a: Point2, b: Point2, keep_clear: Point2) -> bool {
@@ -234,6 +214,8 @@ fn path_free(world: &World, a: Point2, b: Point2, keep_clear: Point2) -> bool {
 #[cfg(test)]
 mod test {
     use super::*;
+    use rand::SeedableRng;
+    use rand_chacha::ChaCha8Rng;
 
     fn straight(speed: f32) -> Walker {
         Walker::new(

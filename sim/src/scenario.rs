@@ -185,6 +185,20 @@ impl Scenario {
         }
     }
 
+    /// Walks 0 to `max` people (uniformly) through the scenario, drawn from `seed`'s own
+    /// salted stream and kept clear of the robot's start ([`Walker::draw`]), so the world,
+    /// robot and LiDAR are the same with or without them. Returns how many walk.
+    pub fn add_people(&mut self, seed: u64, max: usize) -> usize {
+        let clear = Point2::new(self.start_pose.x, self.start_pose.y);
+        let mut rng = ChaCha8Rng::seed_from_u64(seed ^ PEOPLE_SALT);
+        for _ in 0..rng.random_range(0..=max) {
+            if let Some(w) = Walker::draw(&self.world, &mut rng, clear) {
+                self.people.push(w);
+            }
+        }
+        self.people.len()
+    }
+
     /// The robot's pose at the start: the map frame of the output line.
     pub fn robot_start_pose(&self) -> Pose2 {
         self.start_pose
@@ -313,6 +327,9 @@ impl Scenario {
         best
     }
 }
+
+/// Salt of the people's own random stream ([`Scenario::add_people`]).
+const PEOPLE_SALT: u64 = 0x9E0F_1E5B_2A47_C3D8;
 
 /// Farthest a simulated ray looks, m (beyond every LiDAR model's range).
 const MAX_RANGE_M: f32 = 6.0;

@@ -8,7 +8,6 @@ use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use sim::dataset::{scenario_config, scenario_seed};
 use sim::lds01::LIDAR_MOUNT;
-use sim::people::add_people;
 use sim::scenario::{Frame, Scenario};
 use sim::world::grid::Grid;
 use sim::world::{ObjectTruth, Prim, RoomKind, Shape, Surface, World, WorldConfig};
@@ -150,7 +149,7 @@ pub fn generate(seed: u64, i: usize, seconds: f64, varied: f64) -> GeneratedRun 
     let n = (seconds * 5.0) as usize;
     let n_obj = s.world.objects.len();
     let planned = plan_move(&s.world, run_seed, n);
-    add_people(&mut s, run_seed, 2);
+    s.add_people(run_seed, 2);
     let old_footprint = planned.as_ref().map(|m| s.world.objects[m.piece].footprint);
     let mut seen_empty = None;
     let mut returns = vec![0u32; n_obj + 1];
