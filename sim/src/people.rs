@@ -13,16 +13,16 @@ use rand::Rng;
 use crate::world::{Shape, World};
 
 /// Half the distance between a person's feet across the walk, m.
-const HALF_STANCE_M: f32 = 0.09;
+pub const HALF_STANCE_M: f32 = 0.09;
 /// Closest a walker comes to the LiDAR: nearer, it waits (gives way), m.
-const GIVE_WAY_M: f32 = 0.7;
+pub const GIVE_WAY_M: f32 = 0.7;
 /// Longest a walker waits for the robot, s; then it walks on (round it, as people do: the
 /// legs are not drawn within [`ROBOT_RADIUS_M`] of the LiDAR).
-const MAX_WAIT_S: f32 = 1.0;
+pub const MAX_WAIT_S: f32 = 1.0;
 /// Legs nearer the LiDAR than this are inside the robot's body: a person stepping round it.
 pub const ROBOT_RADIUS_M: f32 = 0.2;
 /// Clearance of a waypoint and of the path between waypoints from walls and furniture, m.
-const PATH_CLEARANCE_M: f32 = 0.35;
+pub const PATH_CLEARANCE_M: f32 = 0.35;
 
 /// A person walking a path of waypoints back and forth.
 #[derive(Debug, Clone, PartialEq)]
