@@ -47,6 +47,9 @@ pub struct Walker {
     standing: f32,
     /// Time waited for the robot so far, s.
     waited: f32,
+    /// The legs where they are now ([`Walker::legs`]): kept, since the LiDAR looks at them
+    /// once per reading and they only move in [`Walker::step`].
+    legs_now: [Point2; 2],
 }
 
 impl Walker {
@@ -62,7 +65,7 @@ impl Walker {
         for w in path.windows(2) {
             at_len.push(at_len[at_len.len() - 1] + w[0].distance(w[1]));
         }
-        Walker {
+        let mut w = Walker {
             path,
             at_len,
             speed,
@@ -73,7 +76,16 @@ impl Walker {
             walked: 0.0,
             standing: 0.0,
             waited: 0.0,
-        }
+            legs_now: [Point2::new(0.0, 0.0); 2],
+        };
+        w.walk_to(0.0);
+        w
+    }
+
+    /// Sets the distance walked, and the legs with it.
+    fn walk_to(&mut self, walked: f32) {
+        self.walked = walked;
+        self.legs_now = self.legs_at(walked);
     }
 
     /// Draws a walker in `world`: 2–4 waypoints with free straight paths between them, kept
@@ -101,7 +113,7 @@ impl Walker {
                 let refl = rng.random_range(0.2..0.7);
                 let pause = rng.random_range(0.0..1.0);
                 let mut w = Walker::new(path, speed, leg_r, refl, pause);
-                w.walked = rng.random_range(0.0..w.length());
+                w.walk_to(rng.random_range(0.0..w.length()));
                 return Some(w);
             }
         }
@@ -152,7 +164,12 @@ impl Walker {
     /// The two legs: the planted foot of the nearest footfall, and the other foot swinging in
     /// a straight line from the footfall before it to the one after.
     pub fn legs(&self) -> [Point2; 2] {
-        let x = self.walked / self.step;
+        self.legs_now
+    }
+
+    /// The legs after `walked` metres.
+    fn legs_at(&self, walked: f32) -> [Point2; 2] {
+        let x = walked / self.step;
         let j = (x + 0.5).floor() as i64;
         let u = x + 0.5 - j as f32;
         let (from, to) = (self.foot(j - 1), self.foot(j + 1));
@@ -191,7 +208,7 @@ impl Walker {
         if self.turns_between(self.walked, next) {
             self.standing = self.pause_s;
         }
-        self.walked = next;
+        self.walk_to(next);
     }
 
     /// The legs as ray-castable circles.

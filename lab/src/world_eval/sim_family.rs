@@ -24,6 +24,9 @@ const MOVE_SALT: u64 = 0x4D0F_E5A1_7C3B_9D21;
 /// old place is left empty rather than the piece nudged.
 const MOVE_MIN_M: f32 = 1.5;
 
+/// Most people walking in one run (0 to this many, drawn per run).
+const MAX_WALKERS: usize = 2;
+
 /// A piece taken away (or carried elsewhere) a third of the way into a run.
 struct PlannedMove {
     /// Index of the piece in the world's objects.
@@ -149,7 +152,7 @@ pub fn generate(seed: u64, i: usize, seconds: f64, varied: f64) -> GeneratedRun 
     let n = (seconds * 5.0) as usize;
     let n_obj = s.world.objects.len();
     let planned = plan_move(&s.world, run_seed, n);
-    s.add_people(run_seed, 2);
+    s.add_people(run_seed, MAX_WALKERS);
     let old_footprint = planned.as_ref().map(|m| s.world.objects[m.piece].footprint);
     let mut seen_empty = None;
     let mut returns = vec![0u32; n_obj + 1];
@@ -179,8 +182,14 @@ pub fn generate(seed: u64, i: usize, seconds: f64, varied: f64) -> GeneratedRun 
                 o.t, o.left_ticks, o.right_ticks, o.mag_ut[0], o.mag_ut[1], o.mag_ut[2]
             ));
         }
+        let mut person_returns = [0u32; MAX_WALKERS];
         for r in frame.readings.iter().filter(|r| r.raw.range_mm != 0) {
             match r.hit {
+                Some(Surface::Person(id)) => {
+                    if let Some(n) = person_returns.get_mut(usize::from(id)) {
+                        *n += 1;
+                    }
+                }
                 Some(Surface::Object(k)) => {
                     let k = usize::from(k);
                     returns[k] += 1;
@@ -201,13 +210,7 @@ pub fn generate(seed: u64, i: usize, seconds: f64, varied: f64) -> GeneratedRun 
                 .map(|(id, &at)| Person {
                     id,
                     at: to_map.transform(at),
-                    returns: frame
-                        .readings
-                        .iter()
-                        .filter(|r| {
-                            r.raw.range_mm != 0 && r.hit == Some(Surface::Person(id as u16))
-                        })
-                        .count() as u32,
+                    returns: person_returns.get(id).copied().unwrap_or(0),
                 })
                 .collect(),
         });
