@@ -11,6 +11,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use drivers::opencr::OpencrReader;
 #[cfg(feature = "method-b")]
 use models::yolo::{YoloModel, YoloOptions};
+use perception::scan_match::{ScanMatchConfig, ScanMatcher};
 
 use crate::cli::{Common, ReplayArgs, RunArgs, Speed};
 pub use crate::cli::{EXIT_FAULT, EXIT_USAGE, Failure};
@@ -364,6 +365,11 @@ fn run_loop(
     if let Some(p) = &common.snapshot {
         crate::snapshot::check_path(p).map_err(|m| (EXIT_USAGE, format!("--snapshot {m}")))?;
         sinks.push(Box::new(crate::snapshot::SnapshotSink(p.clone())));
+    }
+    let mut pose = pose;
+    if let Some(p) = pose.as_mut().filter(|_| cfg.pose.scan_match) {
+        p.scan_match = Some(Box::new(ScanMatcher::new(ScanMatchConfig::default())));
+        log::info!("pose: scan matching on (each revolution laid on a keyframe's)");
     }
     let opts = RunOptions {
         frames: common.frames,

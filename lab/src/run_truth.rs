@@ -3,7 +3,7 @@
 //! clutter, walking people frame by frame. Both scene families write this; the scorer reads it.
 
 use perception::class::ObjectClass;
-use perception::geometry::Point2;
+use perception::geometry::{Point2, Pose2};
 
 /// Returns a piece of furniture needs over a run before it counts as visible (the issue's
 /// bar: "furniture that was visible, ≥ 20 returns during the run").
@@ -81,6 +81,9 @@ pub struct FrameTruth {
     pub t: f64,
     /// Walking people.
     pub people: Vec<Person>,
+    /// The robot's true pose (map frame) at the revolution's first ray, when the generator
+    /// knows it: what the line's `pose` (taken at that ray) is scored against.
+    pub robot: Option<Pose2>,
 }
 
 /// A piece of furniture taken away or moved during the run.
@@ -176,7 +179,10 @@ mod test {
     fn frame_at_picks_the_nearest() {
         let t = RunTruth {
             frames: [0.0, 0.2, 0.4]
-                .map(|t| FrameTruth { t, people: vec![] })
+                .map(|t| FrameTruth {
+                    t,
+                    ..FrameTruth::default()
+                })
                 .to_vec(),
             ..RunTruth::default()
         };

@@ -9,6 +9,7 @@
 //! | [`geometry`]   | 2D points and rigid poses in REP 103 (x forward, y left, CCW) |
 //! | [`class`]      | the object classes both methods report, with their wire names |
 //! | [`pose`]       | wheel odometry, hard-iron fit, compass/odometry heading filter |
+//! | [`scan_match`] | each revolution laid on a keyframe's (point-to-line ICP): a pose that does not drift |
 //! | [`raster`]     | three revolutions as the 64 × 384 × 3 image of Method B (bit-exact spec) |
 //! | [`cloud`]      | Method A's global point cloud: a fixed ring with aging |
 //! | [`dbscan`]     | adaptive-ε DBSCAN, grid-indexed and allocation-free |
@@ -51,6 +52,7 @@ pub mod outline;
 pub mod plausible;
 pub mod pose;
 pub mod raster;
+pub mod scan_match;
 pub mod shape;
 pub mod sight;
 pub mod tracks;

@@ -328,6 +328,14 @@ impl PoseFilter {
         self.pose
     }
 
+    /// Moves the pose by `correction`, a rigid motion of the map frame (a scan match's:
+    /// the pose becomes `correction ∘ pose`). North stays where it is: the compass goes on
+    /// correcting the heading as before.
+    pub fn correct(&mut self, correction: &Pose2) {
+        self.pose = correction.compose(&self.pose);
+        self.pose.theta = wrap_angle(self.pose.theta);
+    }
+
     /// Heading variance, rad².
     pub fn heading_variance(&self) -> f32 {
         self.var

@@ -14,6 +14,7 @@ use firmware::runner::{self, MethodBSetup, RunOptions, Schedule, SecondsClock, S
 use firmware::sink::{FrameSink, JsonlSink, SceneSink, StatsSink};
 use firmware::source::{LidarSource, Pacing};
 use firmware::viz::{VizLink, VizSink};
+use perception::scan_match::{ScanMatchConfig, ScanMatcher};
 use umbra_tests::{allocations, counted};
 
 #[global_allocator]
@@ -106,6 +107,21 @@ fn per_frame_from(
 fn frames_allocate_nothing_after_warm_up() {
     let d = per_frame(false);
     println!("allocations per frame, Method A only: {d:?}");
+    assert!(
+        d[WARM_UP..].iter().all(|&n| n == 0),
+        "frames after warm-up allocated: {d:?}"
+    );
+}
+
+#[test]
+fn scan_matching_allocates_nothing_after_warm_up() {
+    let cfg = Config::default();
+    let source = LidarSource::sim(3, 3);
+    let cal = source.sim_calibration();
+    let mut pose = PoseInput::new(PoseState::new(cfg.pose_filter(cal), cal.is_some()));
+    pose.scan_match = Some(Box::new(ScanMatcher::new(ScanMatchConfig::default())));
+    let (d, _) = per_frame_from(source, pose, None, None);
+    println!("allocations per frame, Method A and scan matching: {d:?}");
     assert!(
         d[WARM_UP..].iter().all(|&n| n == 0),
         "frames after warm-up allocated: {d:?}"

@@ -159,6 +159,11 @@ fn buffers_in_code() -> Vec<(&'static str, usize, usize)> {
             size_of::<perception::wall_map::MapWall>(),
         ),
         (
+            "size_of::<perception::scan_match::ScanMatcher>()",
+            1,
+            size_of::<perception::scan_match::ScanMatcher>(),
+        ),
+        (
             "perception::map_doors::MAX_DOORWAYS",
             perception::map_doors::MAX_DOORWAYS,
             size_of::<perception::geometry::Point2>(),

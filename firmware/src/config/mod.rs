@@ -202,6 +202,15 @@ impl Default for OdometrySettings {
     }
 }
 
+/// `[pose]`.
+#[derive(Debug, Clone, PartialEq, Deserialize, Default)]
+#[serde(default, deny_unknown_fields)]
+pub struct PoseSettings {
+    /// Lay each revolution on a keyframe's (`perception::scan_match`, point-to-line ICP) and
+    /// move the pose by what that finds, so that the map does not turn with wheel slip.
+    pub scan_match: bool,
+}
+
 /// `[opencr]`: where the OpenCR firmware keeps the wheel positions (firmware versions differ).
 #[derive(Debug, Clone, PartialEq, Deserialize)]
 #[serde(default, deny_unknown_fields)]
@@ -426,6 +435,8 @@ pub struct Config {
     pub runtime: RuntimeSettings,
     /// Wheel geometry.
     pub odometry: OdometrySettings,
+    /// How the pose is kept.
+    pub pose: PoseSettings,
     /// OpenCR control table.
     pub opencr: OpencrSettings,
     /// Compass calibration and gates.

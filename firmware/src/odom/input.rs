@@ -1,13 +1,17 @@
 //! Where the pose's samples come from, in step with the frames: an `--odom` file read up to
 //! each frame's time, a live source's samples (the simulated robot, the device thread polling
 //! the OpenCR and compass) queued until their frame, or a recording's samples made available
-//! at the frames they were in the recorded run. Every sample goes through one [`PoseState`].
+//! at the frames they were in the recorded run. Every sample goes through one [`PoseState`];
+//! with `[pose] scan_match` each revolution is then laid on a keyframe's
+//! (`perception::scan_match`) and the pose moved by what that finds.
 
 use std::time::Instant;
 
 use heapless::Deque;
 
+use perception::cloud::Scan;
 use perception::geometry::Pose2;
+use perception::scan_match::{MatchOutcome, ScanMatcher};
 
 use super::{OdomFile, OdomRecord, PoseState};
 use crate::reader::{ClockMap, DeviceReader};
@@ -38,6 +42,9 @@ pub struct PoseInput {
     /// ([`crate::recording`]), read at start-up.
     pub scheduled: Vec<(u64, OdomRecord)>,
     scheduled_next: usize,
+    /// The scan matcher (`[pose] scan_match`), which lays each revolution on a keyframe's so
+    /// that the pose does not drift with the wheels; `None`: odometry and compass alone.
+    pub scan_match: Option<Box<ScanMatcher>>,
 }
 
 /// What the pose stage hands the frame: the pose at the first and the last ray, and the
@@ -78,6 +85,27 @@ impl PoseInput {
             clock: ClockMap::default(),
             scheduled: Vec::new(),
             scheduled_next: 0,
+            scan_match: None,
+        }
+    }
+
+    /// Lays the revolution (`ranges` by bin, metres, 0 for none; `mount`: the LiDAR on the
+    /// robot) on the scan matcher's keyframe, if there is a matcher, and moves `pose` and the
+    /// filter's pose by the correction it finds.
+    pub fn match_scan(&mut self, ranges: &[f32], mount: Pose2, pose: &mut FramePose) {
+        let Some(m) = self.scan_match.as_mut() else {
+            return;
+        };
+        let scan = Scan {
+            ranges,
+            start: pose.start,
+            end: pose.end,
+            mount,
+        };
+        if let MatchOutcome::Matched { correction, .. } = m.update(&scan) {
+            pose.start = correction.compose(&pose.start);
+            pose.end = correction.compose(&pose.end);
+            self.state.filter.correct(&correction);
         }
     }
 

@@ -306,11 +306,16 @@ impl<S: RevolutionStream> FrameLoop<'_, S> {
             0.2
         };
         let t_end = t + period * 359.0 / 360.0;
+        for (r, reading) in st.history.next_mut().iter_mut().zip(rev.readings.iter()) {
+            *r = if reading.valid { reading.range_m } else { 0.0 };
+        }
         let pose = opts
             .pose
             .as_mut()
             .map_or(FramePose::STILL, |p: &mut PoseInput| {
-                p.frame(frame, t, t_end, *start)
+                let mut pose = p.frame(frame, t, t_end, *start);
+                p.match_scan(st.history.pending(), mount, &mut pose);
+                pose
             });
         let pose_ms = t_pose.elapsed().as_secs_f64() * 1e3;
 
@@ -319,9 +324,6 @@ impl<S: RevolutionStream> FrameLoop<'_, S> {
         st.fused.clear();
         st.walls.clear();
         st.doors.clear();
-        for (r, reading) in st.history.next_mut().iter_mut().zip(rev.readings.iter()) {
-            *r = if reading.valid { reading.range_m } else { 0.0 };
-        }
         let shrink = opts.method_a.is_some() && st.policy.before_method_a(&opts.budgets);
         let method_a_ms = opts.method_a.as_ref().map(|(cfg, mount)| {
             st.method_a(cfg, mount, shrink, &pose);

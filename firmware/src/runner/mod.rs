@@ -260,6 +260,18 @@ impl<S: RevolutionStream> FrameLoop<'_, S> {
         s.wall_seconds = self.start.elapsed().as_secs_f64();
         s.stop_reason = reason;
         s.viz_dropped = self.opts.sinks.iter().map(|k| k.dropped()).sum();
+        if let Some(m) = self.opts.pose.as_ref().and_then(|p| p.scan_match.as_ref()) {
+            let st = m.stats();
+            log::info!(
+                "scan matching: {} revolutions matched, {} keyframes; refused: {} few pairs, {} residual, {} too far, {} one direction only",
+                st.matched,
+                st.keyframes,
+                st.refused[0],
+                st.refused[1],
+                st.refused[2],
+                st.refused[3]
+            );
+        }
         let cloud: Vec<_> = self.st.method_a.cloud().iter().copied().collect();
         let end = RunEnd {
             frames: s.frames,

@@ -152,9 +152,11 @@ pub fn generate(seed: u64, seconds: f64, tour: bool, lidar: LidarModel) -> Gener
                 returns: 0,
             })
             .collect();
+        let mut robot_at_first_ray = None;
         for i in 0..READINGS_PER_REV {
             let ti = t + i as f64 * dt;
             drive.advance_to(ti);
+            robot_at_first_ray.get_or_insert(drive.pose);
             while next_odom <= ti {
                 let (l, r) = drive.ticks();
                 odom.push_str(&format!(
@@ -229,6 +231,7 @@ pub fn generate(seed: u64, seconds: f64, tour: bool, lidar: LidarModel) -> Gener
         frames.push(FrameTruth {
             t,
             people: mid_people,
+            robot: robot_at_first_ray.map(|p| to_map.compose(&p)),
         });
         t += dt * READINGS_PER_REV as f64;
     }

@@ -375,6 +375,17 @@ pub fn report(outcomes: &[Outcome]) -> String {
                 String::new()
             }
         );
+        if t.pose_frames > 0 {
+            let e = &t.final_position_err_m;
+            let _ = writeln!(
+                s,
+                "  pose against the truth: heading error mean {:.2}° (largest {:.1}°); position at a run's end mean {:.2} m (largest {:.2} m)",
+                t.heading_err_sum_deg / f64::from(t.pose_frames),
+                t.heading_err_max_deg,
+                e.iter().sum::<f64>() / e.len().max(1) as f64,
+                e.iter().copied().fold(0.0, f64::max)
+            );
+        }
         for (name, t) in o.runs.iter().filter(|(_, t)| !t.people_reports.is_empty()) {
             let _ = writeln!(
                 s,

@@ -83,7 +83,12 @@ pub fn write(path: &Path, title: &str, truth: &RunTruth, lines: &[Line]) -> std:
     }
     for pair in lines.windows(2) {
         if let (Some(a), Some(b)) = (pair[0].pose, pair[1].pose) {
-            c.line(px(a), px(b), 1, [200, 40, 160]);
+            c.line(
+                px(Point2::new(a.x, a.y)),
+                px(Point2::new(b.x, b.y)),
+                1,
+                [200, 40, 160],
+            );
         }
     }
     for d in &last.doors {

@@ -4,7 +4,7 @@
 //! and walking people reported as furniture.
 
 use perception::class::ObjectClass;
-use perception::geometry::Point2;
+use perception::geometry::{Point2, Pose2, wrap_angle};
 use serde_json::Value;
 
 use crate::eval_a::class_index;
@@ -59,8 +59,8 @@ pub struct Line {
     pub detections: Option<Vec<Reported>>,
     /// `people` positions, when the line has them.
     pub people: Option<Vec<Point2>>,
-    /// The robot's position.
-    pub pose: Option<Point2>,
+    /// The robot's pose.
+    pub pose: Option<Pose2>,
 }
 
 fn objects(v: Option<&Value>) -> Option<Vec<Reported>> {
@@ -113,9 +113,10 @@ impl Line {
             detections: objects(v.get("detections")),
             people: points(v.get("people")),
             pose: v.get("pose").and_then(|p| {
-                Some(Point2::new(
+                Some(Pose2::new(
                     p.get("x")?.as_f64()? as f32,
                     p.get("y")?.as_f64()? as f32,
+                    p.get("theta")?.as_f64()? as f32,
                 ))
             }),
         })
@@ -189,6 +190,19 @@ pub struct Tally {
     /// `people` entries with no walking person within reach.
     #[serde(default)]
     pub people_phantoms: u32,
+    /// Frames whose `pose` was scored against the robot's true pose, the sum of their
+    /// absolute heading errors (degrees), and the largest.
+    #[serde(default)]
+    pub pose_frames: u32,
+    /// See `pose_frames`.
+    #[serde(default)]
+    pub heading_err_sum_deg: f64,
+    /// See `pose_frames`.
+    #[serde(default)]
+    pub heading_err_max_deg: f64,
+    /// Each run's position error at its last scored frame, m.
+    #[serde(default)]
+    pub final_position_err_m: Vec<f64>,
     /// The reports on walking people, one line each (frame, id, class, source), for reading.
     #[serde(skip)]
     pub people_reports: Vec<String>,
@@ -259,11 +273,21 @@ pub fn score_run(truth: &RunTruth, lines: &[Line], tally: &mut Tally) {
     let mut hyp_ids: Vec<u64> = Vec::new();
     let mut co: Vec<Vec<i64>> = vec![Vec::new(); n_f];
     let mut last_match: Vec<Option<u64>> = vec![None; n_f];
+    let mut last_pose_err = None;
     for line in lines {
         let Some(fi) = truth.frame_at(line.t) else {
             continue;
         };
         tally.frames += 1;
+        if let (Some(p), Some(r)) = (line.pose, truth.frames[fi].robot) {
+            let e = f64::from(wrap_angle(p.theta - r.theta).abs().to_degrees());
+            tally.pose_frames += 1;
+            tally.heading_err_sum_deg += e;
+            tally.heading_err_max_deg = tally.heading_err_max_deg.max(e);
+            last_pose_err = Some(f64::from(
+                Point2::new(p.x, p.y).distance(Point2::new(r.x, r.y)),
+            ));
+        }
         let alive: Vec<&Furniture> = truth.furniture.iter().filter(|f| f.alive(fi)).collect();
         let people = &truth.frames[fi].people;
         if !people.is_empty() {
@@ -386,6 +410,7 @@ pub fn score_run(truth: &RunTruth, lines: &[Line], tally: &mut Tally) {
         }
     }
     tally.idtp += max_assignment(&co) as u32;
+    tally.final_position_err_m.extend(last_pose_err);
 
     // Moves.
     for mv in &truth.moves {
@@ -543,6 +568,11 @@ impl Tally {
             phantoms_by_class,
             phantoms_where
         );
+        self.pose_frames += o.pose_frames;
+        self.heading_err_sum_deg += o.heading_err_sum_deg;
+        self.heading_err_max_deg = self.heading_err_max_deg.max(o.heading_err_max_deg);
+        self.final_position_err_m
+            .extend_from_slice(&o.final_position_err_m);
         self.move_gone_s.extend_from_slice(&o.move_gone_s);
         self.people_reports.extend_from_slice(&o.people_reports);
     }
@@ -603,7 +633,7 @@ mod test {
             frames: (0..4)
                 .map(|k| FrameTruth {
                     t: 0.2 * f64::from(k),
-                    people: vec![],
+                    ..FrameTruth::default()
                 })
                 .collect(),
             moves: vec![],
@@ -643,6 +673,42 @@ mod test {
         assert_eq!(s.phantoms, [0, 0, 0]);
         assert_eq!((s.id_switches, s.idtp, s.id_gt, s.id_hyp), (0, 8, 8, 8));
         assert!((s.idf1() - 1.0).abs() < 1e-9);
+    }
+
+    #[test]
+    fn the_pose_is_scored_against_the_robot_where_the_truth_knows_it() {
+        let mut t = truth();
+        // The robot turns 0.1 rad a frame; the line's heading lags it by 2° from frame 1 on,
+        // across ±π in frame 3, and the last frame's position is 0.3 m off.
+        for (k, f) in t.frames.iter_mut().enumerate() {
+            f.robot = (k != 2).then(|| Pose2::new(0.0, 0.0, wrap_angle(3.0 + 0.1 * k as f32)));
+        }
+        let lines: Vec<Line> = (0..4)
+            .map(|k| {
+                let lag = if k == 0 { 0.0 } else { 2f32.to_radians() };
+                let theta = wrap_angle(3.0 + 0.1 * k as f32 - lag);
+                Line {
+                    t: 0.2 * f64::from(k),
+                    pose: Some(Pose2::new(if k == 3 { 0.3 } else { 0.0 }, 0.0, theta)),
+                    ..Line::default()
+                }
+            })
+            .collect();
+        let mut s = Tally::default();
+        score_run(&t, &lines, &mut s);
+        assert_eq!(s.pose_frames, 3, "frame 2 has no true pose");
+        assert!(
+            (s.heading_err_sum_deg - 4.0).abs() < 1e-3,
+            "{}",
+            s.heading_err_sum_deg
+        );
+        assert!((s.heading_err_max_deg - 2.0).abs() < 1e-3);
+        assert_eq!(s.final_position_err_m.len(), 1);
+        assert!((s.final_position_err_m[0] - 0.3).abs() < 1e-6);
+        let mut sum = Tally::default();
+        sum.add(&s);
+        sum.add(&s);
+        assert_eq!((sum.pose_frames, sum.final_position_err_m.len()), (6, 2));
     }
 
     #[test]
@@ -794,9 +860,14 @@ mod test {
             let (mut xa, mut xs) = (Vec::new(), Vec::new());
             numbers(va, &mut xa);
             numbers(&os[key], &mut xs);
-            if key == "move_gone_s" {
-                // A list of times: concatenated, not doubled.
-                assert_eq!(xs.len(), 2 * xa.len());
+            if key == "move_gone_s" || key == "final_position_err_m" {
+                // A list per run: concatenated, not doubled.
+                assert_eq!(xs.len(), 2 * xa.len(), "{key}");
+                continue;
+            }
+            if key == "heading_err_max_deg" {
+                // The largest of two equal tallies' largest.
+                assert_eq!(xs, xa, "{key}");
                 continue;
             }
             let doubled: Vec<f64> = xa.iter().map(|x| 2.0 * x).collect();

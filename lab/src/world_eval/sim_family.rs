@@ -203,6 +203,7 @@ pub fn generate(seed: u64, i: usize, seconds: f64, varied: f64) -> GeneratedRun 
         }
         frames.push(FrameTruth {
             t: frame.t_start_s,
+            robot: Some(to_map.compose(&frame.pose_start)),
             people: frame
                 .people_mid
                 .iter()
