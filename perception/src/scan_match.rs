@@ -151,18 +151,13 @@ struct Keyframe {
     robot: Pose2,
 }
 
-/// The scan matcher (≈ 6 KiB: two revolutions of points).
+/// The scan matcher (8.7 KiB: two revolutions of points, `memory-budget.md`).
 #[derive(Clone)]
 pub struct ScanMatcher {
     cfg: ScanMatchConfig,
     key: Option<Keyframe>,
     cur: Returns,
     stats: MatchStats,
-}
-
-/// The 2-D cross product's scalar: `a × b`.
-fn cross(a: Point2, b: Point2) -> f32 {
-    a.x * b.y - a.y * b.x
 }
 
 impl ScanMatcher {
@@ -185,11 +180,6 @@ impl ScanMatcher {
         self.stats
     }
 
-    /// Forgets the keyframe (a relocated robot, a new run).
-    pub fn reset(&mut self) {
-        self.key = None;
-    }
-
     /// Matches `scan` (de-skewed with the odometry's poses) against the keyframe, and keeps
     /// it as the next keyframe when the robot has moved on far enough.
     pub fn update(&mut self, scan: &Scan<'_>) -> MatchOutcome {
@@ -201,40 +191,37 @@ impl ScanMatcher {
             return MatchOutcome::Keyframe;
         };
         let pivot = Point2::new(scan.end.x, scan.end.y);
-        let outcome = match self.icp(key, pivot) {
-            Ok((correction, pairs, rms_m)) => MatchOutcome::Matched {
-                correction,
-                pairs,
-                rms_m,
-            },
-            Err(why) => MatchOutcome::Refused(why),
-        };
-        match outcome {
-            MatchOutcome::Matched { correction, .. } => {
+        let key_robot = key.robot;
+        match self.icp(key, pivot) {
+            Ok((correction, pairs, rms_m)) => {
                 self.stats.matched += 1;
-                let robot = correction.compose(&scan.end);
-                let kr = key.robot;
-                let moved = libm::hypotf(robot.x - kr.x, robot.y - kr.y);
-                let turned = libm::fabsf(wrap_angle(robot.theta - kr.theta));
-                if moved >= self.cfg.keyframe_m || turned >= self.cfg.keyframe_rad {
+                if self.beyond(key_robot, correction.compose(&scan.end), 1.0) {
                     self.take_keyframe(scan, correction);
                 }
+                MatchOutcome::Matched {
+                    correction,
+                    pairs,
+                    rms_m,
+                }
             }
-            MatchOutcome::Refused(why) => {
+            Err(why) => {
                 self.stats.refused[why as usize] += 1;
                 // Far from a keyframe it cannot match any more: start again from here
                 // (the odometry's pose, which is the best there is).
-                let kr = key.robot;
-                if libm::hypotf(scan.end.x - kr.x, scan.end.y - kr.y) >= 2.0 * self.cfg.keyframe_m
-                    || libm::fabsf(wrap_angle(scan.end.theta - kr.theta))
-                        >= 2.0 * self.cfg.keyframe_rad
-                {
+                if self.beyond(key_robot, scan.end, 2.0) {
                     self.take_keyframe(scan, Pose2::IDENTITY);
                 }
+                MatchOutcome::Refused(why)
             }
-            MatchOutcome::Keyframe => {}
         }
-        outcome
+    }
+
+    /// Whether `robot` has moved `scale` × `keyframe_m` or turned `scale` × `keyframe_rad`
+    /// from the keyframe's robot pose `key_robot`.
+    fn beyond(&self, key_robot: Pose2, robot: Pose2, scale: f32) -> bool {
+        libm::hypotf(robot.x - key_robot.x, robot.y - key_robot.y) >= scale * self.cfg.keyframe_m
+            || libm::fabsf(wrap_angle(robot.theta - key_robot.theta))
+                >= scale * self.cfg.keyframe_rad
     }
 
     /// The current returns, moved by `correction`, become the keyframe.
@@ -270,8 +257,8 @@ impl ScanMatcher {
         self.stats.keyframes += 1;
     }
 
-    /// The keyframe return nearest `q` among the bins around its bearing, with the line
-    /// through it and its nearer neighbour: (point on the line, unit normal, distance to it).
+    /// The keyframe return nearest `q` (within `gate`) among the bins around its bearing, and
+    /// the unit normal of the line through it and its nearer neighbour.
     fn pair(&self, key: &Keyframe, q: Point2, gate: f32) -> Option<(Point2, Point2)> {
         let dx = q.x - key.lidar.x;
         let dy = q.y - key.lidar.y;
@@ -331,7 +318,7 @@ impl ScanMatcher {
                 };
                 let r = n.x * (q.x - p.x) + n.y * (q.y - p.y);
                 // d(q)/d(th) = perp(rv); the residual's gradient is n · that.
-                let j = Vector3::new(n.x, n.y, cross(rv, n));
+                let j = Vector3::new(n.x, n.y, rv.cross(n));
                 h += j * j.transpose();
                 g += j * r;
                 pairs += 1;
