@@ -368,15 +368,23 @@ fn json_lines(path: &Path) -> Vec<Value> {
 
 /// `umbra replay` of recording `rec` with its odometry into `out`: (output lines, truth lines).
 fn replay_recording(rec: &Path, out: &Path) -> (Vec<Value>, Vec<Value>) {
-    let o = umbra(&[
+    replay_recording_with(rec, out, &[])
+}
+
+/// [`replay_recording`] with more arguments.
+fn replay_recording_with(rec: &Path, out: &Path, more: &[&str]) -> (Vec<Value>, Vec<Value>) {
+    let (cap, odom) = (rec.join("capture.bin"), rec.join("odom.jsonl"));
+    let mut args = vec![
         "replay",
-        rec.join("capture.bin").to_str().unwrap(),
+        cap.to_str().unwrap(),
         "--odom",
-        rec.join("odom.jsonl").to_str().unwrap(),
+        odom.to_str().unwrap(),
         "--jsonl",
         out.to_str().unwrap(),
         "--quiet",
-    ]);
+    ];
+    args.extend_from_slice(more);
+    let o = umbra(&args);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     (json_lines(out), json_lines(&rec.join("truth.jsonl")))
 }
@@ -384,9 +392,16 @@ fn replay_recording(rec: &Path, out: &Path) -> (Vec<Value>, Vec<Value>) {
 #[test]
 fn replay_with_odometry_follows_the_true_pose() {
     let dir = recordings("odom-ds", 2, 40, 5);
-    // Scenario 1 drives a waypoint tour.
+    // Scenario 1 drives a waypoint tour. The wheels' pose alone (no scan matching: the pose
+    // filter's arithmetic is what is checked here).
     let rec = dir.join("recordings/s0001");
-    let (frames, truth) = replay_recording(&rec, &tmp("odom.jsonl"));
+    let no_match = tmp("no-scan-match.toml");
+    std::fs::write(&no_match, "[pose]\nscan_match = false\n").unwrap();
+    let (frames, truth) = replay_recording_with(
+        &rec,
+        &tmp("odom.jsonl"),
+        &["--config", no_match.to_str().unwrap()],
+    );
     assert_eq!(frames.len(), truth.len());
     let f = |v: &Value| v.as_f64().unwrap();
     let last = frames.last().unwrap();
@@ -460,6 +475,30 @@ fn replay_with_odometry_follows_the_true_pose() {
     // plausibility only.
     assert!(worst.0 < 0.05 && worst.1 < 10.0, "{worst:?}");
     assert_eq!(last["faults"]["encoder_errors"], 0);
+    // With scan matching (the default) the same replay is laid on the scans: its heading is
+    // no further from the truth than the wheels' alone, at any frame.
+    let (matched, _) = replay_recording(&rec, &tmp("odom-matched.jsonl"));
+    let heading_err = |lines: &[Value]| -> f64 {
+        lines
+            .iter()
+            .zip(&truth)
+            .map(|(a, b)| {
+                (f(&a["pose"]["theta"]) - f(&b["pose"]["theta"]))
+                    .sin()
+                    .asin()
+                    .abs()
+                    .to_degrees()
+            })
+            .fold(0.0, f64::max)
+    };
+    let (wheels, scans) = (heading_err(&frames), heading_err(&matched));
+    println!(
+        "worst heading error against the truth: wheels {wheels:.2}°, scan matched {scans:.2}°"
+    );
+    assert!(
+        scans <= wheels + 0.1,
+        "{scans:.2}° scan matched, {wheels:.2}° wheels"
+    );
     let _ = std::fs::remove_dir_all(&dir);
 }
 
@@ -473,6 +512,10 @@ fn bad_odometry_lines_are_counted_not_fatal() {
         "{\"t\": 0.0, \"left_ticks\": 0, \"right_ticks\": 0}\nnot json\n{\"t\": 0.5, \"left_ticks\": \"x\"}\n{\"t\": 1.0, \"left_ticks\": 100, \"right_ticks\": 100}\n",
     )
     .unwrap();
+    // The capture is of a robot standing still: scan matching (the default) would rightly hold
+    // it where it is, so it is off to see the good lines' ticks move the pose.
+    let no_match = tmp("odom-bad.toml");
+    std::fs::write(&no_match, "[pose]\nscan_match = false\n").unwrap();
     let o = umbra(&[
         "replay",
         cap.to_str().unwrap(),
@@ -481,6 +524,8 @@ fn bad_odometry_lines_are_counted_not_fatal() {
         "--jsonl",
         "-",
         "--quiet",
+        "--config",
+        no_match.to_str().unwrap(),
     ]);
     assert!(o.status.success());
     let s = String::from_utf8(o.stdout).unwrap();

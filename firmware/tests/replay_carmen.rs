@@ -53,9 +53,15 @@ fn replay(log: &Path, frames: Option<usize>) -> (Vec<serde_json::Value>, String)
         std::process::id()
     ));
     std::fs::create_dir_all(&dir).unwrap();
-    // The learned method was trained on a 360° LDS-01, not a 180° SICK: Method A only.
+    // The learned method was trained on a 360° LDS-01, not a 180° SICK: Method A only. Scan
+    // matching off: what is checked is that the log's poses come through the wheel-tick pose
+    // filter; the matcher on these logs is `tests/tests/real_scan_match.rs`'s.
     let cfg = dir.join("cfg.toml");
-    std::fs::write(&cfg, "[method_b]\nenabled = false\n").unwrap();
+    std::fs::write(
+        &cfg,
+        "[method_b]\nenabled = false\n[pose]\nscan_match = false\n",
+    )
+    .unwrap();
     let out_path = dir.join("out.jsonl");
     let mut cmd = Command::new(env!("CARGO_BIN_EXE_umbra"));
     cmd.arg("replay")

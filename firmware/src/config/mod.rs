@@ -82,10 +82,12 @@ use std::path::{Path, PathBuf};
 use drivers::lds01::AssemblerConfig;
 use drivers::opencr::OpencrConfig;
 use perception::method_a::MethodAConfig;
-use perception::pose::{HeadingConfig, OdometryConfig};
 use serde::Deserialize;
 
+mod pose;
 mod views;
+
+pub use pose::{CompassSettings, OdometrySettings, PoseSettings};
 
 /// Checksum policy as written in the file.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Default)]
@@ -179,38 +181,6 @@ pub struct StageBudgets {
     pub output: Option<f64>,
 }
 
-/// `[odometry]`.
-#[derive(Debug, Clone, PartialEq, Deserialize)]
-#[serde(default, deny_unknown_fields)]
-pub struct OdometrySettings {
-    /// Wheel radius, m.
-    pub wheel_radius_m: f32,
-    /// Wheel separation, m.
-    pub wheel_separation_m: f32,
-    /// Encoder ticks per wheel turn.
-    pub ticks_per_rev: f32,
-}
-
-impl Default for OdometrySettings {
-    fn default() -> Self {
-        let b = OdometryConfig::BURGER;
-        OdometrySettings {
-            wheel_radius_m: b.wheel_radius_m,
-            wheel_separation_m: b.wheel_separation_m,
-            ticks_per_rev: b.ticks_per_rev,
-        }
-    }
-}
-
-/// `[pose]`.
-#[derive(Debug, Clone, PartialEq, Deserialize, Default)]
-#[serde(default, deny_unknown_fields)]
-pub struct PoseSettings {
-    /// Lay each revolution on a keyframe's (`perception::scan_match`, point-to-line ICP) and
-    /// move the pose by what that finds, so that the map does not turn with wheel slip.
-    pub scan_match: bool,
-}
-
 /// `[opencr]`: where the OpenCR firmware keeps the wheel positions (firmware versions differ).
 #[derive(Debug, Clone, PartialEq, Deserialize)]
 #[serde(default, deny_unknown_fields)]
@@ -233,32 +203,6 @@ impl Default for OpencrSettings {
             left_addr: d.left_addr,
             right_addr: d.right_addr,
             timeout_ms: d.timeout.as_millis() as u64,
-        }
-    }
-}
-
-/// `[compass]`.
-#[derive(Debug, Clone, PartialEq, Deserialize)]
-#[serde(default, deny_unknown_fields)]
-pub struct CompassSettings {
-    /// Hard-iron offset (x, y), µT; `None`: the compass is not used.
-    pub hard_iron_ut: Option<[f32; 2]>,
-    /// Clean-field reference from the calibration (horizontal strength, vertical reading), µT:
-    /// readings that differ are disturbed and not used.
-    pub field_reference_ut: Option<[f32; 2]>,
-    /// Declination plus mount offset, degrees.
-    pub offset_deg: f32,
-    /// Accepted deviation of the horizontal field strength, fraction.
-    pub field_tolerance: f32,
-}
-
-impl Default for CompassSettings {
-    fn default() -> Self {
-        CompassSettings {
-            hard_iron_ut: None,
-            field_reference_ut: None,
-            offset_deg: 0.0,
-            field_tolerance: HeadingConfig::default().field_tolerance,
         }
     }
 }
