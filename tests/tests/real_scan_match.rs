@@ -108,6 +108,8 @@ struct Run {
     matched: (f64, f64),
     /// Scans matched, refused, keyframes.
     counts: (u32, u32, u32),
+    /// Refusals by reason: few pairs, residual, too far, degenerate.
+    refused: [u32; 4],
 }
 
 fn run(scans: &[LogScan], mount: Pose2, turn_gain: f32, distance_gain: f32) -> Run {
@@ -141,6 +143,7 @@ fn run(scans: &[LogScan], mount: Pose2, turn_gain: f32, distance_gain: f32) -> R
         odometry: relative_errors(&odo_poses, scans),
         matched: relative_errors(&est_poses, scans),
         counts: (st.matched, refused, st.keyframes),
+        refused: st.refused,
     }
 }
 
@@ -154,10 +157,11 @@ fn check(name: &str, mount_x_m: f32) {
     for (label, turn_gain, distance_gain) in [("clean", 1.0, 1.0), ("slipping", 1.04, 0.98)] {
         let r = run(&scans, mount, turn_gain, distance_gain);
         println!(
-            "{name}, {label} wheels, {} scans: matched {}, refused {}, keyframes {}; error over {WINDOW} scans: heading {:.2}° -> {:.2}°, position {:.3} m -> {:.3} m",
+            "{name}, {label} wheels, {} scans: matched {}, refused {} (few pairs, residual, too far, corridor: {:?}), keyframes {}; error over {WINDOW} scans: heading {:.2}° -> {:.2}°, position {:.3} m -> {:.3} m",
             scans.len(),
             r.counts.0,
             r.counts.1,
+            r.refused,
             r.counts.2,
             r.odometry.0,
             r.matched.0,
