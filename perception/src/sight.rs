@@ -1,6 +1,7 @@
 //! What one revolution showed of a footprint in the map: hidden, in plain view, or seen empty
-//! (every ray across it returned from beyond); and of a doorway, which rays passing through
-//! do not speak against. The world model's negative evidence. `no_std`.
+//! (every ray across it returned from beyond, or — for a piece of furniture well within reach
+//! — returned nothing); and of a doorway, which rays passing through do not speak against. The
+//! world model's negative evidence. `no_std`.
 
 use crate::geometry::{Point2, Pose2};
 
@@ -39,6 +40,8 @@ struct Across {
     before: u32,
     inside: u32,
     beyond: u32,
+    /// Rays with no return at all.
+    none: u32,
 }
 
 /// The bins of this revolution (`ranges`, from `lidar`) across a disc of radius `r` m at
@@ -66,7 +69,8 @@ fn across(
     for d in lo..=hi {
         let range = ranges[d.rem_euclid(BINS as i32) as usize];
         if range <= 0.0 || !range.is_finite() {
-            continue; // no return: says nothing (dark surfaces drop out)
+            a.none += 1;
+            continue;
         }
         if range < dist - r {
             a.before += 1;
@@ -84,6 +88,37 @@ fn across(
 pub fn view(centre: Point2, r: f32, lidar: &Pose2, ranges: &[f32; BINS], max_range_m: f32) -> View {
     match across(centre, r, lidar, ranges, max_range_m) {
         Some(a) if a.inside == 0 && a.beyond >= 2 && a.beyond >= a.before => View::Empty,
+        Some(a) if a.inside > 0 && a.inside >= a.before => View::Plain,
+        _ => View::Hidden,
+    }
+}
+
+/// Share of the LiDAR's reach within which a ray with no return across a footprint counts as
+/// seen through ([`footprint_view`]): farther, a chair's thin legs can fall between the rays.
+pub const NEAR_SHARE: f32 = 0.8;
+
+/// [`view`] of a piece of furniture's footprint, where a ray with no return also crossed it:
+/// the footprint is within the LiDAR's reach (`max_range_m`), so a piece standing there would
+/// have returned it, unless it is dark; what lies beyond may be out of reach (a far wall). Seen
+/// empty needs no ray ending in it and at least three crossing it, no fewer than end in front.
+pub fn footprint_view(
+    centre: Point2,
+    r: f32,
+    lidar: &Pose2,
+    ranges: &[f32; BINS],
+    max_range_m: f32,
+) -> View {
+    let near = {
+        let local = lidar.inverse().transform(centre);
+        libm::sqrtf(local.x * local.x + local.y * local.y) + r <= NEAR_SHARE * max_range_m
+    };
+    match across(centre, r, lidar, ranges, max_range_m) {
+        Some(a) if a.inside == 0 && a.beyond >= 2 && a.beyond >= a.before => View::Empty,
+        Some(a)
+            if near && a.inside == 0 && a.beyond + a.none >= 3 && a.beyond + a.none >= a.before =>
+        {
+            View::Empty
+        }
         Some(a) if a.inside > 0 && a.inside >= a.before => View::Plain,
         _ => View::Hidden,
     }
@@ -162,6 +197,32 @@ mod test {
         assert_eq!(look(&r), View::Hidden);
         // No return at all says nothing.
         assert_eq!(look(&[0.0; BINS]), View::Hidden);
+    }
+
+    #[test]
+    fn a_footprint_within_reach_is_seen_through_where_the_rays_return_nothing() {
+        // The far wall beyond the LiDAR's reach: no ray returns. A piece 2 m ahead would have
+        // returned some; it is seen empty — as a footprint is by `view` only when the rays
+        // return from beyond it.
+        let near =
+            |r: &[f32; BINS]| footprint_view(Point2::new(2.0, 0.0), 0.35, &Pose2::IDENTITY, r, 3.5);
+        let none = [0.0; BINS];
+        assert_eq!(near(&none), View::Empty);
+        assert_eq!(look(&none), View::Hidden);
+        // Its far edge past 0.8 of the reach (2.6 + 0.35 > 2.8 m): a chair's legs can fall
+        // between the rays there, so no return says nothing.
+        let far =
+            |r: &[f32; BINS]| footprint_view(Point2::new(2.6, 0.0), 0.35, &Pose2::IDENTITY, r, 3.5);
+        assert_eq!(far(&none), View::Hidden);
+        // A ray that ends in it: in plain view, whatever the others did.
+        let mut r = none;
+        r[2] = 2.1;
+        assert_eq!(near(&r), View::Plain);
+        // Behind something nearer in most of its bins: hidden.
+        let mut r = none;
+        r[350..BINS].fill(1.0);
+        r[..8].fill(1.0);
+        assert_eq!(near(&r), View::Hidden);
     }
 
     #[test]

@@ -413,9 +413,13 @@ impl Tracks {
         }
         // Negative evidence for the unmatched tracks in view.
         if pose_ok {
+            // Rays with no return show a place empty only in a revolution that returned
+            // elsewhere: one that returned (almost) nothing is a blinded or faulty LiDAR.
+            let returned = ranges.iter().filter(|r| **r > 0.0 && r.is_finite()).count();
+            let trust_none = returned >= negative::MIN_RETURNS;
             for (i, t) in self.tracks.iter_mut().enumerate() {
                 if !matched[i] {
-                    negative::unobserved(t, lidar, ranges, looked, cfg);
+                    negative::unobserved(t, lidar, ranges, looked, trust_none, cfg);
                 }
             }
         }
@@ -750,6 +754,46 @@ mod test {
     }
 
     #[test]
+    fn a_moved_object_leaves_when_the_wall_behind_its_place_is_out_of_reach() {
+        // The room returns all round (walls at 1.5 m) but ahead, where the wall is beyond the
+        // LiDAR's reach: those rays return nothing.
+        let mut room = ranges(1.5);
+        room[330..].fill(0.0);
+        room[..30].fill(0.0);
+        let mut with_box = room;
+        for d in [358usize, 359, 0, 1, 2] {
+            with_box[d] = 1.9;
+        }
+        for blinded in [false, true] {
+            let mut t = Tracks::new();
+            let cfg = quick();
+            for f in 0..6 {
+                step(
+                    &mut t,
+                    f,
+                    &[obs(ObjectClass::Box, 2.0, 0.0, 0.9, Evidence::AB)],
+                    &Pose2::IDENTITY,
+                    &with_box,
+                    &cfg,
+                );
+            }
+            assert_eq!(t.confirmed().count(), 1);
+            // Carried away; or a LiDAR that returns nothing at all (nothing can be said).
+            let after = if blinded { ranges(0.0) } else { room };
+            let mut frames = 0;
+            while !t.all().is_empty() && frames < 20 {
+                frames += 1;
+                step(&mut t, 5 + frames, &[], &Pose2::IDENTITY, &after, &cfg);
+            }
+            if blinded {
+                assert_eq!(t.confirmed().count(), 1, "a blinded LiDAR erased the map");
+            } else {
+                assert!(frames <= 10, "gone after {frames} frames (2 s: 10)");
+            }
+        }
+    }
+
+    #[test]
     fn out_of_view_or_occluded_tracks_keep_their_state() {
         let mut t = Tracks::new();
         // One method confirms as fast as two here: this test is about something else.
@@ -769,7 +813,8 @@ mod test {
             );
         }
         let before = t.all()[0];
-        // Something stands in front of it (returns at 1 m), then nothing returns at all.
+        // Something stands in front of it (returns at 1 m), then nothing returns at all (a
+        // blinded LiDAR: no ray with no return is then taken to have passed through).
         for (f, scan) in [(4, ranges(1.0)), (5, ranges(0.0))] {
             step(&mut t, f, &[], &Pose2::IDENTITY, &scan, &cfg);
         }

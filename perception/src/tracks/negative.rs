@@ -14,7 +14,7 @@
 use super::{Track, TrackConfig};
 use crate::class::ObjectClass;
 use crate::geometry::Pose2;
-use crate::sight::{BINS, DoorView, View, doorway_view, view};
+use crate::sight::{BINS, DoorView, View, doorway_view, footprint_view, view};
 
 /// Which methods looked in a frame (ran, and their detections are among the frame's).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -36,12 +36,19 @@ impl Looked {
     }
 }
 
-/// Applies this frame's negative evidence to `t`, which took no observation.
+/// Returns a revolution needs before its rays with no return count as passing through a
+/// piece's footprint (`trust_none` of [`unobserved`]; a tenth of the bins).
+pub(super) const MIN_RETURNS: usize = BINS / 10;
+
+/// Applies this frame's negative evidence to `t`, which took no observation. `trust_none`:
+/// whether a ray with no return across a piece of furniture's footprint within reach passed
+/// through it ([`footprint_view`]; not in a revolution that returned almost nothing).
 pub(super) fn unobserved(
     t: &mut Track,
     lidar: &Pose2,
     ranges: &[f32; BINS],
     looked: Looked,
+    trust_none: bool,
     cfg: &TrackConfig,
 ) {
     let looked_for = looked.for_track(t);
@@ -60,7 +67,14 @@ pub(super) fn unobserved(
             DoorView::Hidden => (0.0, false),
         }
     } else {
-        match view(t.centre, t.radius(), lidar, ranges, cfg.max_range_m) {
+        // A door frame not yet anchored in the map's walls is an opening all the same: rays
+        // with no return through it are the room beyond, out of reach.
+        let look = if t.class() == ObjectClass::DoorFrame || !trust_none {
+            view
+        } else {
+            footprint_view
+        };
+        match look(t.centre, t.radius(), lidar, ranges, cfg.max_range_m) {
             View::Empty => (cfg.free_loss, true),
             View::Plain if looked_for => (cfg.miss_loss, true),
             View::Plain | View::Hidden => (0.0, false),
