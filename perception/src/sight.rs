@@ -30,7 +30,8 @@ pub enum View {
     Plain,
     /// Seen empty: no ray ended in it, at least two crossed it and returned from beyond, and
     /// no fewer than ended in front of it (a footprint partly behind something nearer is still
-    /// seen through where the rays reach it).
+    /// seen through where the rays reach it). [`footprint_view`] also counts rays with no
+    /// return across a footprint well within reach.
     Empty,
 }
 
@@ -69,6 +70,7 @@ fn across(
     for d in lo..=hi {
         let range = ranges[d.rem_euclid(BINS as i32) as usize];
         if range <= 0.0 || !range.is_finite() {
+            // No return: a dark surface that dropped out, or nothing within reach.
             a.none += 1;
             continue;
         }
