@@ -366,6 +366,13 @@ fn json_lines(path: &Path) -> Vec<Value> {
         .collect()
 }
 
+/// A configuration file that turns scan matching off (the wheels' pose alone).
+fn no_scan_match() -> PathBuf {
+    let path = tmp("no-scan-match.toml");
+    std::fs::write(&path, "[pose]\nscan_match = false\n").unwrap();
+    path
+}
+
 /// `umbra replay` of recording `rec` with its odometry into `out`: (output lines, truth lines).
 fn replay_recording(rec: &Path, out: &Path) -> (Vec<Value>, Vec<Value>) {
     replay_recording_with(rec, out, &[])
@@ -395,8 +402,7 @@ fn replay_with_odometry_follows_the_true_pose() {
     // Scenario 1 drives a waypoint tour. The wheels' pose alone (no scan matching: the pose
     // filter's arithmetic is what is checked here).
     let rec = dir.join("recordings/s0001");
-    let no_match = tmp("no-scan-match.toml");
-    std::fs::write(&no_match, "[pose]\nscan_match = false\n").unwrap();
+    let no_match = no_scan_match();
     let (frames, truth) = replay_recording_with(
         &rec,
         &tmp("odom.jsonl"),
@@ -478,20 +484,18 @@ fn replay_with_odometry_follows_the_true_pose() {
     // With scan matching (the default) the same replay is laid on the scans: its heading is
     // no further from the truth than the wheels' alone, at any frame.
     let (matched, _) = replay_recording(&rec, &tmp("odom-matched.jsonl"));
-    let heading_err = |lines: &[Value]| -> f64 {
-        lines
-            .iter()
-            .zip(&truth)
-            .map(|(a, b)| {
-                (f(&a["pose"]["theta"]) - f(&b["pose"]["theta"]))
-                    .sin()
-                    .asin()
-                    .abs()
-                    .to_degrees()
-            })
-            .fold(0.0, f64::max)
-    };
-    let (wheels, scans) = (heading_err(&frames), heading_err(&matched));
+    let scans = matched
+        .iter()
+        .zip(&truth)
+        .map(|(a, b)| {
+            (f(&a["pose"]["theta"]) - f(&b["pose"]["theta"]))
+                .sin()
+                .asin()
+                .abs()
+                .to_degrees()
+        })
+        .fold(0.0, f64::max);
+    let wheels = worst.1;
     println!(
         "worst heading error against the truth: wheels {wheels:.2}°, scan matched {scans:.2}°"
     );
@@ -514,8 +518,7 @@ fn bad_odometry_lines_are_counted_not_fatal() {
     .unwrap();
     // The capture is of a robot standing still: scan matching (the default) would rightly hold
     // it where it is, so it is off to see the good lines' ticks move the pose.
-    let no_match = tmp("odom-bad.toml");
-    std::fs::write(&no_match, "[pose]\nscan_match = false\n").unwrap();
+    let no_match = no_scan_match();
     let o = umbra(&[
         "replay",
         cap.to_str().unwrap(),

@@ -43,6 +43,8 @@ struct Across {
     beyond: u32,
     /// Rays with no return at all.
     none: u32,
+    /// Distance from the LiDAR to the disc's centre, m.
+    dist: f32,
 }
 
 /// The bins of this revolution (`ranges`, from `lidar`) across a disc of radius `r` m at
@@ -66,7 +68,10 @@ fn across(
         libm::ceilf(bearing - half) as i32,
         libm::floorf(bearing + half) as i32,
     );
-    let mut a = Across::default();
+    let mut a = Across {
+        dist,
+        ..Across::default()
+    };
     for d in lo..=hi {
         let range = ranges[d.rem_euclid(BINS as i32) as usize];
         if range <= 0.0 || !range.is_finite() {
@@ -88,8 +93,22 @@ fn across(
 /// What this revolution (`ranges`, from `lidar`) showed of a footprint of radius `r` m at
 /// `centre` (map frame); nothing beyond `max_range_m`.
 pub fn view(centre: Point2, r: f32, lidar: &Pose2, ranges: &[f32; BINS], max_range_m: f32) -> View {
-    match across(centre, r, lidar, ranges, max_range_m) {
+    seen(across(centre, r, lidar, ranges, max_range_m), false)
+}
+
+/// What the bins across a footprint say; `none_passes`: whether rays with no return crossed it
+/// (see [`footprint_view`]).
+fn seen(across: Option<Across>, none_passes: bool) -> View {
+    match across {
         Some(a) if a.inside == 0 && a.beyond >= 2 && a.beyond >= a.before => View::Empty,
+        Some(a)
+            if none_passes
+                && a.inside == 0
+                && a.beyond + a.none >= 3
+                && a.beyond + a.none >= a.before =>
+        {
+            View::Empty
+        }
         Some(a) if a.inside > 0 && a.inside >= a.before => View::Plain,
         _ => View::Hidden,
     }
@@ -110,20 +129,9 @@ pub fn footprint_view(
     ranges: &[f32; BINS],
     max_range_m: f32,
 ) -> View {
-    let near = {
-        let local = lidar.inverse().transform(centre);
-        libm::sqrtf(local.x * local.x + local.y * local.y) + r <= NEAR_SHARE * max_range_m
-    };
-    match across(centre, r, lidar, ranges, max_range_m) {
-        Some(a) if a.inside == 0 && a.beyond >= 2 && a.beyond >= a.before => View::Empty,
-        Some(a)
-            if near && a.inside == 0 && a.beyond + a.none >= 3 && a.beyond + a.none >= a.before =>
-        {
-            View::Empty
-        }
-        Some(a) if a.inside > 0 && a.inside >= a.before => View::Plain,
-        _ => View::Hidden,
-    }
+    let a = across(centre, r, lidar, ranges, max_range_m);
+    let near = a.is_some_and(|a| a.dist + r <= NEAR_SHARE * max_range_m);
+    seen(a, near)
 }
 
 /// What a revolution showed of a doorway (an opening in a wall between two jambs).

@@ -15,7 +15,7 @@ use std::path::{Path, PathBuf};
 
 use perception::cloud::Scan;
 use perception::geometry::{Pose2, wrap_angle};
-use perception::scan_match::{BINS, MatchOutcome, ScanMatchConfig, ScanMatcher};
+use perception::scan_match::{BINS, MatchOutcome, MatchStats, ScanMatchConfig, ScanMatcher};
 
 /// Scans between the two poses of a relative error.
 const WINDOW: usize = 20;
@@ -23,18 +23,13 @@ const WINDOW: usize = 20;
 const NO_RETURN_M: f32 = 80.0;
 
 fn shared_log(name: &str) -> Option<PathBuf> {
-    let p = Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../../shared/data/carmen")
-        .join(name);
-    if p.is_file() {
-        Some(p)
-    } else {
-        println!(
-            "skipped: {} is absent (the shared data lives beside the repository)",
-            p.display()
-        );
-        None
+    let p = umbra_tests::shared_data()
+        .map(|d| d.join("carmen").join(name))
+        .filter(|p| p.is_file());
+    if p.is_none() {
+        println!("skipped: ../shared/data/carmen/{name} is absent beside the repository");
     }
+    p
 }
 
 /// One scan: ranges binned by degree as the runtime bins them (closest return wins a bin), and
@@ -106,17 +101,14 @@ struct Run {
     /// Relative errors of the odometry alone, and with the matcher.
     odometry: (f64, f64),
     matched: (f64, f64),
-    /// Scans matched, refused, keyframes.
-    counts: (u32, u32, u32),
-    /// Refusals by reason: few pairs, residual, too far, degenerate.
-    refused: [u32; 4],
+    /// The matcher's counts.
+    stats: MatchStats,
 }
 
 fn run(scans: &[LogScan], mount: Pose2, turn_gain: f32, distance_gain: f32) -> Run {
     let mut m = ScanMatcher::new(ScanMatchConfig::default());
     let (mut odo, mut est) = (scans[0].pose, scans[0].pose);
     let (mut odo_poses, mut est_poses) = (Vec::new(), Vec::new());
-    let mut refused = 0;
     for (k, s) in scans.iter().enumerate() {
         if k > 0 {
             let step = odometry_step(&scans[k - 1].pose, &s.pose, turn_gain, distance_gain);
@@ -130,20 +122,16 @@ fn run(scans: &[LogScan], mount: Pose2, turn_gain: f32, distance_gain: f32) -> R
             end: est,
             mount,
         };
-        match m.update(&scan) {
-            MatchOutcome::Matched { correction, .. } => est = correction.compose(&est),
-            MatchOutcome::Refused(_) => refused += 1,
-            MatchOutcome::Keyframe => {}
+        if let MatchOutcome::Matched { correction, .. } = m.update(&scan) {
+            est = correction.compose(&est);
         }
         odo_poses.push(odo);
         est_poses.push(est);
     }
-    let st = m.stats();
     Run {
         odometry: relative_errors(&odo_poses, scans),
         matched: relative_errors(&est_poses, scans),
-        counts: (st.matched, refused, st.keyframes),
-        refused: st.refused,
+        stats: m.stats(),
     }
 }
 
@@ -159,10 +147,10 @@ fn check(name: &str, mount_x_m: f32) {
         println!(
             "{name}, {label} wheels, {} scans: matched {}, refused {} (few pairs, residual, too far, corridor: {:?}), keyframes {}; error over {WINDOW} scans: heading {:.2}° -> {:.2}°, position {:.3} m -> {:.3} m",
             scans.len(),
-            r.counts.0,
-            r.counts.1,
-            r.refused,
-            r.counts.2,
+            r.stats.matched,
+            r.stats.refused.iter().sum::<u32>(),
+            r.stats.refused,
+            r.stats.keyframes,
             r.odometry.0,
             r.matched.0,
             r.odometry.1,
@@ -174,9 +162,9 @@ fn check(name: &str, mount_x_m: f32) {
     // Most scans match (the rest are refused: too few returns within the 3.5 m the matcher
     // uses, or a corridor).
     assert!(
-        clean.counts.0 * 10 >= scans.len() as u32 * 7,
+        clean.stats.matched * 10 >= scans.len() as u32 * 7,
         "matched {} of {}",
-        clean.counts.0,
+        clean.stats.matched,
         scans.len()
     );
     // Slipping wheels: the scans take most of the heading error out.
