@@ -368,7 +368,11 @@ fn run_loop(
     }
     let mut pose = pose;
     if let Some(p) = pose.as_mut().filter(|_| cfg.pose.scan_match) {
-        p.scan_match = Some(Box::new(ScanMatcher::new(ScanMatchConfig::default())));
+        // The matcher uses the returns the LiDAR is trusted with (`[lidar] max_range_m`).
+        p.scan_match = Some(Box::new(ScanMatcher::new(ScanMatchConfig {
+            max_range_m: cfg.lidar.max_range_m,
+            ..ScanMatchConfig::default()
+        })));
         log::info!("pose: scan matching on (each revolution laid on a keyframe's)");
     }
     let opts = RunOptions {

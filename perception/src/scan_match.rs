@@ -51,7 +51,8 @@ pub struct ScanMatchConfig {
     pub keyframe_m: f32,
     /// ... or has turned this much, rad.
     pub keyframe_rad: f32,
-    /// Returns beyond this range are not used, m (the far, sparse returns pair badly).
+    /// Returns beyond this range are not used, m: the LiDAR's reach (`umbra` gives it
+    /// `[lidar] max_range_m`; farther returns helped on real scans, `docs/pose.md`).
     pub max_range_m: f32,
 }
 

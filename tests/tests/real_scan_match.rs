@@ -105,8 +105,12 @@ struct Run {
     stats: MatchStats,
 }
 
-fn run(scans: &[LogScan], mount: Pose2, turn_gain: f32, distance_gain: f32) -> Run {
-    let mut m = ScanMatcher::new(ScanMatchConfig::default());
+/// The matcher over a log; `reach_m`: the farthest return it uses (the LiDAR's reach).
+fn run(scans: &[LogScan], mount: Pose2, turn_gain: f32, distance_gain: f32, reach_m: f32) -> Run {
+    let mut m = ScanMatcher::new(ScanMatchConfig {
+        max_range_m: reach_m,
+        ..ScanMatchConfig::default()
+    });
     let (mut odo, mut est) = (scans[0].pose, scans[0].pose);
     let (mut odo_poses, mut est_poses) = (Vec::new(), Vec::new());
     for (k, s) in scans.iter().enumerate() {
@@ -142,10 +146,16 @@ fn check(name: &str, mount_x_m: f32) {
     let scans = read_log(&log);
     let mount = Pose2::new(mount_x_m, 0.0, 0.0);
     let mut runs = Vec::new();
-    for (label, turn_gain, distance_gain) in [("clean", 1.0, 1.0), ("slipping", 1.04, 0.98)] {
-        let r = run(&scans, mount, turn_gain, distance_gain);
+    // An LDS-01's reach (3.5 m), and an 8 m one (an LDS-02's, as `umbra` ties the matcher's
+    // reach to `[lidar] max_range_m`).
+    for (label, turn_gain, distance_gain, reach_m) in [
+        ("clean", 1.0, 1.0, 3.5),
+        ("slipping", 1.04, 0.98, 3.5),
+        ("slipping", 1.04, 0.98, 8.0),
+    ] {
+        let r = run(&scans, mount, turn_gain, distance_gain, reach_m);
         println!(
-            "{name}, {label} wheels, {} scans: matched {}, refused {} (few pairs, residual, too far, corridor: {:?}), keyframes {}; error over {WINDOW} scans: heading {:.2}° -> {:.2}°, position {:.3} m -> {:.3} m",
+            "{name}, {label} wheels, reach {reach_m} m, {} scans: matched {}, refused {} (few pairs, residual, too far, corridor: {:?}), keyframes {}; error over {WINDOW} scans: heading {:.2}° -> {:.2}°, position {:.3} m -> {:.3} m",
             scans.len(),
             r.stats.matched,
             r.stats.refused.iter().sum::<u32>(),
@@ -158,7 +168,7 @@ fn check(name: &str, mount_x_m: f32) {
         );
         runs.push(r);
     }
-    let (clean, slipping) = (&runs[0], &runs[1]);
+    let (clean, slipping, far) = (&runs[0], &runs[1], &runs[2]);
     // Most scans match (the rest are refused: too few returns within the 3.5 m the matcher
     // uses, or a corridor).
     assert!(
@@ -173,6 +183,15 @@ fn check(name: &str, mount_x_m: f32) {
         "heading {:.2}° matched, {:.2}° wheels",
         slipping.matched.0,
         slipping.odometry.0
+    );
+    // The farther returns a longer-reaching LiDAR gives help rather than hurt.
+    assert!(
+        far.matched.0 <= slipping.matched.0 && far.stats.matched >= slipping.stats.matched,
+        "reach 8 m: {:.2}°, {} matched; 3.5 m: {:.2}°, {} matched",
+        far.matched.0,
+        far.stats.matched,
+        slipping.matched.0,
+        slipping.stats.matched
     );
     // Clean wheels (the corrected poses themselves): what the matcher adds is bounded — a
     // fraction of a degree a match, not a drift that grows with the tour.

@@ -15,8 +15,8 @@
 //!
 //! [runtime.budget_ms]      # per-stage budgets; each defaults to a share of the deadline
 //! ingest = 10              # 4 %
-//! pose = 5                 # 2 %
-//! method_a = 80            # 32 %
+//! pose = 20                # 8 %  (scan matching: up to 18 ms a frame on a Pi 3)
+//! method_a = 65            # 26 %
 //! method_b = 140           # 56 %
 //! output = 15              # 6 %
 //!
@@ -171,9 +171,9 @@ pub enum Scheduling {
 pub struct StageBudgets {
     /// Ingest (4 % of the deadline).
     pub ingest: Option<f64>,
-    /// Pose (2 %).
+    /// Pose (8 %: scan matching, projected up to 18 ms a frame on a Pi 3).
     pub pose: Option<f64>,
-    /// Method A (32 %).
+    /// Method A (26 %).
     pub method_a: Option<f64>,
     /// Method B (56 %).
     pub method_b: Option<f64>,
@@ -548,6 +548,24 @@ mod test {
     fn defaults_are_valid() {
         Config::default().validate().unwrap();
         assert_eq!(Config::default().lds01(), Lds01Config::default());
+    }
+
+    #[test]
+    fn default_budgets_share_the_deadline_and_fit_a_pi_3() {
+        let b = Config::default().budgets();
+        let sum = b.ingest_ms + b.pose_ms + b.method_a_ms + b.method_b_ms + b.output_ms;
+        assert!(
+            (sum - b.deadline_ms).abs() < 1e-9,
+            "{sum} of {}",
+            b.deadline_ms
+        );
+        // docs/pi-budget.md: scan matching projects up to 18 ms a frame on a Pi 3 (32-bit),
+        // Method A up to 23 ms: their defaults must hold the slow end.
+        assert!(b.pose_ms >= 18.0 && b.method_a_ms >= 23.0, "{b:?}");
+        // A share set in the file replaces the default; the others keep theirs.
+        let c: Config = toml::from_str("[runtime.budget_ms]\npose = 7.0\n").unwrap();
+        assert_eq!(c.budgets().pose_ms, 7.0);
+        assert_eq!(c.budgets().method_a_ms, b.method_a_ms);
     }
 
     #[test]

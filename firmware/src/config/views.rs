@@ -27,8 +27,8 @@ impl Config {
         crate::deadline::Budgets {
             deadline_ms: d,
             ingest_ms: b.ingest.unwrap_or(d * 0.04),
-            pose_ms: b.pose.unwrap_or(d * 0.02),
-            method_a_ms: b.method_a.unwrap_or(d * 0.32),
+            pose_ms: b.pose.unwrap_or(d * 0.08),
+            method_a_ms: b.method_a.unwrap_or(d * 0.26),
             method_b_ms: b.method_b.unwrap_or(d * 0.56),
             output_ms: b.output.unwrap_or(d * 0.06),
         }
