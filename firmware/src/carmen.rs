@@ -88,6 +88,44 @@ pub fn front_laser_offset(text: &[u8]) -> Option<f32> {
         })
 }
 
+/// The fields of a `FLASER` line after its type (`tok` yields them): its beams' ranges as
+/// written into `ranges` (cleared first), the odometry pose (x, y, θ) and the stamp. `None`
+/// when a field is missing or not a finite number, or the beam count is outside
+/// 1..=[`MAX_BEAMS`].
+pub fn parse_flaser<'a>(
+    tok: &mut impl Iterator<Item = &'a str>,
+    ranges: &mut Vec<f32>,
+) -> Option<((f64, f64, f64), f64)> {
+    let mut num = || {
+        tok.next()
+            .and_then(|v| v.parse::<f64>().ok())
+            .filter(|v| v.is_finite())
+    };
+    let n = num()?;
+    if !(1.0..=MAX_BEAMS as f64).contains(&n) || n.fract() != 0.0 {
+        return None;
+    }
+    // n ranges, the laser pose (x y θ), the odometry pose, then the stamp.
+    ranges.clear();
+    for _ in 0..n as usize {
+        ranges.push(num()? as f32);
+    }
+    let _laser = (num()?, num()?, num()?);
+    let odom = (num()?, num()?, num()?);
+    Some((odom, num()?))
+}
+
+/// Bearing of beam `k` of a scan of `n`, degrees: evenly over 180° from −90° (right).
+pub fn beam_bearing_deg(k: usize, n: usize) -> f32 {
+    -90.0 + k as f32 * 180.0 / n as f32
+}
+
+/// A beam's range as the pipeline takes it: 0 (no return) at or beyond [`NO_RETURN_M`] or not
+/// positive.
+pub fn beam_range_m(r: f32) -> f32 {
+    if r >= NO_RETURN_M || r <= 0.0 { 0.0 } else { r }
+}
+
 /// Counters of the log reader.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
 pub struct CarmenStats {
@@ -240,36 +278,22 @@ impl CarmenStream {
         match tok.next() {
             None => Ok(false),
             Some("FLASER") => {
-                let n = num(tok.next())?;
-                if !(1.0..=MAX_BEAMS as f64).contains(&n) || n.fract() != 0.0 {
-                    return Err(());
-                }
-                let n = n as usize;
-                // n ranges, the laser pose (x y θ), the odometry pose, then the stamp.
                 let mut ranges = std::mem::take(&mut self.ranges);
-                ranges.clear();
-                let parsed: Result<_, ()> = (|| {
-                    for _ in 0..n {
-                        ranges.push(num(tok.next())? as f32);
-                    }
-                    let _laser = (num(tok.next())?, num(tok.next())?, num(tok.next())?);
-                    let odom = (num(tok.next())?, num(tok.next())?, num(tok.next())?);
-                    Ok((odom, num(tok.next())?))
-                })();
-                let Ok(((x, y, th), stamp)) = parsed else {
+                let parsed = parse_flaser(&mut tok, &mut ranges);
+                let Some(((x, y, th), stamp)) = parsed else {
                     self.ranges = ranges;
                     return Err(());
                 };
+                let n = ranges.len();
                 let t = self.clock(stamp).max(self.t_last_scan);
                 self.t_last_scan = t;
                 self.odometry(t, x, y, th);
                 for (k, &r) in ranges.iter().enumerate() {
-                    let range_m = if r >= NO_RETURN_M || r <= 0.0 { 0.0 } else { r };
-                    let angle_deg = -90.0 + k as f32 * 180.0 / n as f32;
+                    let angle_deg = beam_bearing_deg(k, n);
                     let p = Point {
                         angle_deg,
                         sweep_deg: angle_deg,
-                        range_m,
+                        range_m: beam_range_m(r),
                         intensity: 0,
                         t_s: t,
                     };

@@ -10,8 +10,10 @@
 //! corrected logs are locally accurate; their global frame comes from loop closures no local
 //! matcher has). Skipped, with the reason printed, when the shared data is absent.
 
-use std::io::Read as _;
 use std::path::{Path, PathBuf};
+
+use drivers::lidar::points::bin_of;
+use firmware::carmen;
 
 use perception::cloud::Scan;
 use perception::geometry::{Pose2, wrap_angle};
@@ -19,8 +21,6 @@ use perception::scan_match::{BINS, MatchOutcome, MatchStats, ScanMatchConfig, Sc
 
 /// Scans between the two poses of a relative error.
 const WINDOW: usize = 20;
-/// A range at or beyond this is no return (SICK: 81.83 or 81.91 m).
-const NO_RETURN_M: f32 = 80.0;
 
 fn shared_log(name: &str) -> Option<PathBuf> {
     let p = umbra_tests::shared_data()
@@ -32,41 +32,36 @@ fn shared_log(name: &str) -> Option<PathBuf> {
     p
 }
 
-/// One scan: ranges binned by degree as the runtime bins them (closest return wins a bin), and
-/// the corrected pose.
+/// One scan: ranges binned by degree as the runtime bins them (`firmware::carmen`'s parsing,
+/// `drivers`' bins: the closest return wins a bin), and the corrected pose.
 struct LogScan {
     ranges: Vec<f32>,
     pose: Pose2,
 }
 
 fn read_log(log: &Path) -> Vec<LogScan> {
-    let mut text = String::new();
-    flate2::read::GzDecoder::new(std::fs::File::open(log).unwrap())
-        .read_to_string(&mut text)
-        .unwrap();
-    text.lines()
+    let text = carmen::read_log(log).unwrap();
+    let mut beams = Vec::new();
+    String::from_utf8_lossy(&text)
+        .lines()
         .filter_map(|l| {
-            let t: Vec<&str> = l.split_whitespace().collect();
-            if t.first() != Some(&"FLASER") {
+            let mut tok = l.split_ascii_whitespace();
+            if tok.next() != Some("FLASER") {
                 return None;
             }
-            let n: usize = t[1].parse().unwrap();
+            let ((x, y, theta), _stamp) = carmen::parse_flaser(&mut tok, &mut beams)
+                .expect("every FLASER line of the log parses");
             let mut ranges = vec![0.0f32; BINS];
-            for k in 0..n {
-                let r: f32 = t[2 + k].parse().unwrap();
-                if !(r > 0.0 && r < NO_RETURN_M) {
-                    continue;
-                }
-                let bearing = -90.0 + k as f32 * 180.0 / n as f32;
-                let bin = (bearing.round() as i32).rem_euclid(BINS as i32) as usize;
-                if ranges[bin] == 0.0 || r < ranges[bin] {
+            for (k, &r) in beams.iter().enumerate() {
+                let r = carmen::beam_range_m(r);
+                let bin = bin_of(carmen::beam_bearing_deg(k, beams.len()));
+                if r > 0.0 && (ranges[bin] == 0.0 || r < ranges[bin]) {
                     ranges[bin] = r;
                 }
             }
-            let f = |k: usize| t[2 + n + 3 + k].parse::<f32>().unwrap();
             Some(LogScan {
                 ranges,
-                pose: Pose2::new(f(0), f(1), f(2)),
+                pose: Pose2::new(x as f32, y as f32, theta as f32),
             })
         })
         .collect()
