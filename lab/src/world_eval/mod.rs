@@ -225,6 +225,13 @@ pub fn describe(t: &crate::run_truth::RunTruth) -> String {
             },
             f.returns
         );
+        // The footprint, for reading a run's phantoms against the shape they stand beside.
+        s.pop();
+        s.push_str(", footprint");
+        for q in &f.footprint {
+            let _ = write!(s, " ({:.2}, {:.2})", q.x, q.y);
+        }
+        s.push('\n');
     }
     for d in &t.doors {
         let _ = writeln!(
