@@ -209,9 +209,9 @@ pub fn describe(t: &crate::run_truth::RunTruth) -> String {
     let mut s = format!("{}\n", t.name);
     for (k, f) in t.furniture.iter().enumerate() {
         let c = f.centre();
-        let _ = writeln!(
+        let _ = write!(
             s,
-            "furniture {k} (piece {}): {} {} at ({:.2}, {:.2}), frames {}..{}, {} returns",
+            "furniture {k} (piece {}): {} {} at ({:.2}, {:.2}), frames {}..{}, {} returns, footprint",
             f.piece,
             f.class.as_str(),
             f.what,
@@ -226,8 +226,6 @@ pub fn describe(t: &crate::run_truth::RunTruth) -> String {
             f.returns
         );
         // The footprint, for reading a run's phantoms against the shape they stand beside.
-        s.pop();
-        s.push_str(", footprint");
         for q in &f.footprint {
             let _ = write!(s, " ({:.2}, {:.2})", q.x, q.y);
         }
