@@ -38,6 +38,10 @@ pub const IN_WALL_M: f32 = 0.08;
 pub const BEHIND_M: f32 = 0.2;
 /// Beyond a line's ends its band still reaches this far, m.
 pub const END_MARGIN_M: f32 = 0.05;
+/// Two lines meet in a corner where they cross within this of an end of each, m.
+pub const CORNER_JOIN_M: f32 = 0.4;
+/// Sine of the smallest angle between two lines that meet in a corner (45°).
+const CORNER_MIN_SIN: f32 = 0.707;
 /// Weight at most of a line's past when a segment joins it (so a line can still settle).
 const MAX_WEIGHT: f32 = 20.0;
 /// Side votes are kept within ±this.
@@ -333,6 +337,33 @@ impl WallMap {
         }
     }
 
+    /// Whether a corner of the map's walls lies within `r` m of `p`: two confirmed lines at
+    /// 45° or more to each other whose lines cross within [`CORNER_JOIN_M`] of an end of each
+    /// (an L's corner, inner or outer, or a T).
+    pub fn corner_near(&self, p: Point2, r: f32) -> bool {
+        if !(p.x.is_finite() && p.y.is_finite()) {
+            return false;
+        }
+        let near_end = |w: &MapWall, x: Point2| {
+            let (a, b) = w.ends();
+            a.distance(x) <= CORNER_JOIN_M || b.distance(x) <= CORNER_JOIN_M
+        };
+        let walls = &self.walls;
+        walls.iter().enumerate().any(|(i, a)| {
+            a.confirmed()
+                && walls[i + 1..].iter().any(|b| {
+                    let det = a.dir.cross(b.dir);
+                    if !b.confirmed() || libm::fabsf(det) < CORNER_MIN_SIN {
+                        return false;
+                    }
+                    // origin_a + s dir_a = origin_b + u dir_b
+                    let s = (b.origin - a.origin).cross(b.dir) / det;
+                    let x = a.at(s);
+                    x.distance(p) <= r && near_end(a, x) && near_end(b, x)
+                })
+        })
+    }
+
     /// Whether `p` lies in a confirmed wall's band: less than [`IN_WALL_M`] in front of its
     /// face or up to [`BEHIND_M`] behind it, within its extent — unless `p` is well in front
     /// of another confirmed line facing the other way there (the far side of a thin wall
@@ -416,6 +447,37 @@ mod test {
         // The longer line spans both pieces.
         let long = map.walls().iter().map(MapWall::length).fold(0.0, f32::max);
         assert!((long - 3.0).abs() < 0.05, "{long}");
+    }
+
+    #[test]
+    fn corners_are_where_two_lines_meet_at_an_angle() {
+        let mut map = WallMap::new();
+        // An L's inner corner at (1, 2) seen from the origin: y = 2 for x ≤ 1, then x = 1
+        // for y ≥ 2; and a doorway (0.9 m gap) in the first wall at x = −1.55.
+        seen(
+            &mut map,
+            &[
+                seg(-3.0, 2.0, -2.0, 2.0),
+                seg(-1.1, 2.0, 1.0, 2.0),
+                seg(1.0, 2.0, 1.0, 4.0),
+            ],
+            3,
+        );
+        assert!(map.corner_near(Point2::new(0.8, 1.8), 0.45));
+        assert!(map.corner_near(Point2::new(1.0, 2.0), 0.05));
+        // The doorway's middle is no corner: its jambs' lines are one line.
+        assert!(!map.corner_near(Point2::new(-1.55, 2.0), 0.45));
+        // Nor is a point along a wall, or beyond a line's end where another line's would cross.
+        assert!(!map.corner_near(Point2::new(0.0, 2.0), 0.45));
+        assert!(!map.corner_near(Point2::new(f32::NAN, 2.0), 0.45));
+        // Two lines whose extensions cross far from either's end meet nowhere.
+        let mut apart = WallMap::new();
+        seen(
+            &mut apart,
+            &[seg(-3.0, 2.0, -1.0, 2.0), seg(1.0, 3.0, 1.0, 5.0)],
+            3,
+        );
+        assert!(!apart.corner_near(Point2::new(1.0, 2.0), 0.45));
     }
 
     #[test]

@@ -412,6 +412,8 @@ impl<S: RevolutionStream> FrameLoop<'_, S> {
             );
             // Door frames in a doorway of the map's walls are openings in a wall.
             st.tracks.anchor_doors(&doorways);
+            // Nor is Method B's door frame at a corner of them.
+            st.tracks.mark_corner_doors(&st.wall_map);
             // How wide the boxes look: a bin or a post is narrower than any box.
             st.tracks.measure_widths(&lidar, &returns);
             // People: leg-sized blobs of this revolution off the map's walls, tracked; the

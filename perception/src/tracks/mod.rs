@@ -18,7 +18,8 @@
 //!    that end before it (something in front) say nothing. A door frame the map's walls showed
 //!    as a doorway ([`Tracks::anchor_doors`]) is an opening: rays through it are what it looks
 //!    like; it loses belief when its middle is seen closed, or when the rays pass its jambs'
-//!    places too (open floor).
+//!    places too (open floor). A door frame only Method B has seen, at a corner of the map's
+//!    walls and in no doorway of them, is not reported ([`Tracks::mark_corner_doors`]).
 //! 4. **New tracks** from unmatched observations (non-finite or absurd ones are refused and
 //!    counted); when the table is full the weakest tentative track, else the weakest track, is
 //!    evicted (counted).
@@ -40,6 +41,7 @@ use crate::fusion::{Evidence, FrameObject};
 use crate::geometry::{Point2, Pose2};
 use crate::motion::{Motion, MotionConfig};
 use crate::sight::BINS;
+use crate::wall_map::WallMap;
 
 mod merge;
 mod negative;
@@ -53,6 +55,11 @@ pub const MAX_TRACKS: usize = 64;
 
 /// Narrow views before a "box" never seen box-wide is not reported ([`Track::too_narrow`]).
 pub const NARROW_VIEWS: u16 = 3;
+
+/// A door frame's centre this close to a corner of the map's walls is at the corner, m: a
+/// doorway beside a corner has its centre at least half its width (0.38 m) plus the jamb's
+/// piece of wall from it.
+pub const CORNER_DOOR_M: f32 = 0.45;
 
 /// A person is listed while seen in one of this many frames.
 pub const PEOPLE_FRAMES: u64 = 3;
@@ -165,6 +172,8 @@ pub struct Track {
     pub box_wide_views: u16,
     /// See `box_wide_views`.
     pub narrow_views: u16,
+    /// A door frame at a corner of the map's walls ([`Tracks::mark_corner_doors`]).
+    pub at_corner: bool,
 }
 
 impl Track {
@@ -208,6 +217,13 @@ impl Track {
             && self.narrow_views >= NARROW_VIEWS
     }
 
+    /// A door frame only Method B has seen, not in a doorway of the map's walls, at a corner
+    /// of them: the end of a wall seen end-on looks like a jamb to Method B (an L-shaped
+    /// room's inner corner). Not reported while so.
+    pub fn door_at_corner(&self) -> bool {
+        self.class() == ObjectClass::DoorFrame && self.at_corner && !self.seen_a && !self.anchored
+    }
+
     /// Radius of the footprint negative evidence looks across, m (a desk's legs span ~1.8 m).
     fn radius(&self) -> f32 {
         class_radius(self.class())
@@ -220,7 +236,8 @@ impl Track {
 fn earns_report(t: &Track, cfg: &TrackConfig) -> bool {
     let base = t.motion.settled(&cfg.motion)
         && t.hits >= cfg.confirm_hits
-        && t.existence >= cfg.confirm_existence;
+        && t.existence >= cfg.confirm_existence
+        && !t.door_at_corner();
     base && (t.agreed
         || (t.hits >= cfg.single_method_hits
             && t.hits as f32 >= cfg.single_method_rate * t.views as f32))
@@ -464,6 +481,7 @@ impl Tracks {
                 anchored: false,
                 box_wide_views: 0,
                 narrow_views: 0,
+                at_corner: false,
             };
             Self::hit(&mut t, o, frame, stamp_s, cfg);
             if self.tracks.push(t).is_ok() {
@@ -541,6 +559,19 @@ impl Tracks {
                     .any(|d| d.distance(t.centre) <= class_radius(ObjectClass::DoorFrame))
             {
                 t.anchored = true;
+            }
+        }
+    }
+
+    /// Door-frame tracks within [`CORNER_DOOR_M`] of a corner of the map's walls: see
+    /// [`Track::door_at_corner`]; one reported is reported no more.
+    pub fn mark_corner_doors(&mut self, walls: &WallMap) {
+        for t in self.tracks.iter_mut() {
+            if t.class() == ObjectClass::DoorFrame {
+                t.at_corner = walls.corner_near(t.centre, CORNER_DOOR_M);
+                if t.door_at_corner() {
+                    t.confirmed = false;
+                }
             }
         }
     }
@@ -932,6 +963,51 @@ mod test {
             &cfg,
         );
         assert_eq!(t.all().len(), 2);
+    }
+
+    #[test]
+    fn method_b_door_frames_at_a_corner_of_the_walls_are_not_reported() {
+        use crate::walls::test_seg as seg;
+        let cfg = TrackConfig {
+            single_method_hits: 3,
+            ..quick()
+        };
+        // An L's inner corner at (1, 2), the map's walls seen from the origin.
+        let mut walls = WallMap::new();
+        for f in 0..3 {
+            walls.update(
+                f,
+                &[seg(-3.0, 2.0, 1.0, 2.0), seg(1.0, 2.0, 1.0, 4.0)],
+                Point2::new(0.0, 0.0),
+            );
+        }
+        let scan = ranges(0.0);
+        for (evidence, reported) in [(Evidence::B, 0), (Evidence::A, 1)] {
+            let mut t = Tracks::new();
+            let door = obs(ObjectClass::DoorFrame, 0.85, 1.8, 0.9, evidence);
+            for f in 0..6 {
+                step(&mut t, f, &[door], &Pose2::IDENTITY, &scan, &cfg);
+                t.mark_corner_doors(&walls);
+            }
+            assert_eq!(t.confirmed().count(), reported, "{evidence:?}");
+        }
+        // Away from the corner, in the wall's middle, Method B's door frame is reported.
+        let mut t = Tracks::new();
+        let door = obs(ObjectClass::DoorFrame, -1.5, 1.9, 0.9, Evidence::B);
+        for f in 0..6 {
+            step(&mut t, f, &[door], &Pose2::IDENTITY, &scan, &cfg);
+            t.mark_corner_doors(&walls);
+        }
+        assert_eq!(t.confirmed().count(), 1);
+        // One reported before the walls were known stops being reported once they are.
+        let mut t = Tracks::new();
+        let door = obs(ObjectClass::DoorFrame, 0.85, 1.8, 0.9, Evidence::B);
+        for f in 0..6 {
+            step(&mut t, f, &[door], &Pose2::IDENTITY, &scan, &cfg);
+        }
+        assert_eq!(t.confirmed().count(), 1);
+        t.mark_corner_doors(&walls);
+        assert_eq!(t.confirmed().count(), 0);
     }
 
     #[test]
