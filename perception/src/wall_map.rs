@@ -339,27 +339,32 @@ impl WallMap {
 
     /// Whether a corner of the map's walls lies within `r` m of `p`: two confirmed lines at
     /// 45° or more to each other whose lines cross within [`CORNER_JOIN_M`] of an end of each
-    /// (an L's corner, inner or outer, or a T).
+    /// (an L's corner, inner or outer; not where a wall meets another's middle).
     pub fn corner_near(&self, p: Point2, r: f32) -> bool {
         if !(p.x.is_finite() && p.y.is_finite()) {
             return false;
         }
-        let near_end = |w: &MapWall, x: Point2| {
+        let near_end = |w: &MapWall, x: Point2, d: f32| {
             let (a, b) = w.ends();
-            a.distance(x) <= CORNER_JOIN_M || b.distance(x) <= CORNER_JOIN_M
+            a.distance(x) <= d || b.distance(x) <= d
         };
+        // Each of the two lines has an end within r + CORNER_JOIN_M of `p`: most pairs are
+        // ruled out by that alone (the map holds up to MAX_MAP_WALLS lines).
+        let candidate = |w: &MapWall| w.confirmed() && near_end(w, p, r + CORNER_JOIN_M);
         let walls = &self.walls;
         walls.iter().enumerate().any(|(i, a)| {
-            a.confirmed()
+            candidate(a)
                 && walls[i + 1..].iter().any(|b| {
                     let det = a.dir.cross(b.dir);
-                    if !b.confirmed() || libm::fabsf(det) < CORNER_MIN_SIN {
+                    if !candidate(b) || libm::fabsf(det) < CORNER_MIN_SIN {
                         return false;
                     }
                     // origin_a + s dir_a = origin_b + u dir_b
                     let s = (b.origin - a.origin).cross(b.dir) / det;
                     let x = a.at(s);
-                    x.distance(p) <= r && near_end(a, x) && near_end(b, x)
+                    x.distance(p) <= r
+                        && near_end(a, x, CORNER_JOIN_M)
+                        && near_end(b, x, CORNER_JOIN_M)
                 })
         })
     }
@@ -467,7 +472,7 @@ mod test {
         assert!(map.corner_near(Point2::new(1.0, 2.0), 0.05));
         // The doorway's middle is no corner: its jambs' lines are one line.
         assert!(!map.corner_near(Point2::new(-1.55, 2.0), 0.45));
-        // Nor is a point along a wall, or beyond a line's end where another line's would cross.
+        // Nor is a point along a wall.
         assert!(!map.corner_near(Point2::new(0.0, 2.0), 0.45));
         assert!(!map.corner_near(Point2::new(f32::NAN, 2.0), 0.45));
         // Two lines whose extensions cross far from either's end meet nowhere.
