@@ -982,29 +982,26 @@ mod test {
             );
         }
         let scan = ranges(0.0);
-        for (evidence, reported) in [(Evidence::B, 0), (Evidence::A, 1)] {
+        // A door frame at (x, y) seen in six frames; the corners marked after each, or not.
+        let seen = |x: f32, y: f32, evidence: Evidence, mark: bool| {
             let mut t = Tracks::new();
-            let door = obs(ObjectClass::DoorFrame, 0.85, 1.8, 0.9, evidence);
+            let door = obs(ObjectClass::DoorFrame, x, y, 0.9, evidence);
             for f in 0..6 {
                 step(&mut t, f, &[door], &Pose2::IDENTITY, &scan, &cfg);
-                t.mark_corner_doors(&walls);
+                if mark {
+                    t.mark_corner_doors(&walls);
+                }
             }
+            t
+        };
+        for (evidence, reported) in [(Evidence::B, 0), (Evidence::A, 1)] {
+            let t = seen(0.85, 1.8, evidence, true);
             assert_eq!(t.confirmed().count(), reported, "{evidence:?}");
         }
         // Away from the corner, in the wall's middle, Method B's door frame is reported.
-        let mut t = Tracks::new();
-        let door = obs(ObjectClass::DoorFrame, -1.5, 1.9, 0.9, Evidence::B);
-        for f in 0..6 {
-            step(&mut t, f, &[door], &Pose2::IDENTITY, &scan, &cfg);
-            t.mark_corner_doors(&walls);
-        }
-        assert_eq!(t.confirmed().count(), 1);
+        assert_eq!(seen(-1.5, 1.9, Evidence::B, true).confirmed().count(), 1);
         // One reported before the walls were known stops being reported once they are.
-        let mut t = Tracks::new();
-        let door = obs(ObjectClass::DoorFrame, 0.85, 1.8, 0.9, Evidence::B);
-        for f in 0..6 {
-            step(&mut t, f, &[door], &Pose2::IDENTITY, &scan, &cfg);
-        }
+        let mut t = seen(0.85, 1.8, Evidence::B, false);
         assert_eq!(t.confirmed().count(), 1);
         t.mark_corner_doors(&walls);
         assert_eq!(t.confirmed().count(), 0);
