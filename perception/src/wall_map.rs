@@ -34,8 +34,13 @@ pub const CONFIRM_FRAMES: u32 = 3;
 /// wall has its centre at least half its depth (≥ 0.15 m) in front.
 pub const IN_WALL_M: f32 = 0.08;
 /// A centre up to this far behind a wall's face is in the wall (or a mixed pixel, or a
-/// completion into the wall), m.
-pub const BEHIND_M: f32 = 0.2;
+/// completion into the wall: a box or chair class's centre completion pushes a piece of wall
+/// seen at an angle 0.2–0.4 m behind the face), m. Furniture in the next room has its centre
+/// further behind: a wall's thickness plus half its depth.
+pub const BEHIND_M: f32 = 0.4;
+/// A centre this far in front of the other face of a thin wall (up to [`IN_WALL_M`] more) is
+/// furniture against it in the next room, m.
+pub const FAR_SIDE_M: f32 = 0.2;
 /// Beyond a line's ends its band still reaches this far, m.
 pub const END_MARGIN_M: f32 = 0.05;
 /// Two lines meet in a corner where they cross within this of an end of each, m.
@@ -391,7 +396,7 @@ impl WallMap {
                         v.confirmed()
                             && within(v)
                             && v.room_normal().dot(w.room_normal()) < -0.9
-                            && (IN_WALL_M..BEHIND_M + IN_WALL_M).contains(&v.in_front(p))
+                            && (IN_WALL_M..FAR_SIDE_M + IN_WALL_M).contains(&v.in_front(p))
                     })
             })
     }
@@ -426,6 +431,8 @@ mod test {
         assert!(map.holds(Point2::new(0.0, 2.0)));
         assert!(map.holds(Point2::new(1.0, 1.95)));
         assert!(map.holds(Point2::new(-1.9, 2.15)));
+        // A piece of the wall completed into a box's centre, 0.35 m behind the face.
+        assert!(map.holds(Point2::new(-1.0, 2.35)));
         // A box against the wall (centre half its depth in front), the room, far beyond it.
         assert!(!map.holds(Point2::new(0.5, 1.8)));
         assert!(!map.holds(Point2::new(0.0, 0.5)));
