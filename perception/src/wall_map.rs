@@ -35,8 +35,10 @@ pub const CONFIRM_FRAMES: u32 = 3;
 pub const IN_WALL_M: f32 = 0.08;
 /// A centre up to this far behind a wall's face is in the wall (or a mixed pixel, or a
 /// completion into the wall: a box or chair class's centre completion pushes a piece of wall
-/// seen at an angle 0.2–0.4 m behind the face), m. Furniture in the next room has its centre
-/// further behind: a wall's thickness plus half its depth.
+/// seen at an angle 0.2–0.4 m behind the face), m. Furniture against the wall's other side,
+/// in the next room, can have its centre within this too (a wall's thickness plus half its
+/// depth, 0.25–0.35 m): it is told from the wall only where the other face is a confirmed
+/// line ([`FAR_SIDE_M`]).
 pub const BEHIND_M: f32 = 0.4;
 /// A centre this far in front of the other face of a thin wall (up to [`IN_WALL_M`] more) is
 /// furniture against it in the next room, m.
