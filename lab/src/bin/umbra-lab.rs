@@ -1,8 +1,8 @@
 //! `umbra-lab`: umbra's workbench (host only; never flashed to a robot).
 //!
-//! * `umbra-lab forest-data --out models/data/forest-train.csv [--seed 1] [--scenes 300]`
-//!   runs Method A on training scenes of the simulator and writes one labelled row per
-//!   candidate (both feature frames).
+//! * `umbra-lab forest-data --out models/data/forest-train.csv [--seed 1] [--scenes 600]
+//!   [--clutter 6] [--varied 0.5]` runs Method A on training scenes of the simulator (half of
+//!   them varied worlds) and writes one labelled row per candidate (both feature frames).
 //! * `umbra-lab forest-train [--data …] [--out models/src/forest_tables.rs] [--frame object]`
 //!   fits the scaler and forest and writes the constant tables.
 //! * `umbra-lab eval-a [--seed 2] [--scenes 200] [--confusion docs/method-a-confusion.png]`
@@ -69,12 +69,17 @@ enum Command {
         out: PathBuf,
         #[arg(long, default_value_t = 1)]
         seed: u64,
-        #[arg(long, default_value_t = 300)]
+        #[arg(long, default_value_t = 600)]
         scenes: usize,
         #[arg(long, value_enum, default_value = "odometry")]
         pose: Pose,
-        #[command(flatten)]
-        worlds: Worlds,
+        /// Most clutter items per scene.
+        #[arg(long, default_value_t = 6)]
+        clutter: usize,
+        /// Share of worlds drawn varied (`umbra-sim dataset --varied`): the "none" class
+        /// learns wall pieces of other thickness, reach and dropout, shelves and pillars.
+        #[arg(long, default_value_t = 0.5)]
+        varied: f64,
     },
     /// Trains the forest and writes its tables.
     ForestTrain {
@@ -252,9 +257,10 @@ fn run(cli: Cli) -> Result<(), String> {
             seed,
             scenes,
             pose,
-            worlds,
+            clutter,
+            varied,
         } => {
-            let cfg = scene_cfg(seed, pose, worlds);
+            let cfg = scene_cfg(seed, pose, Worlds { clutter, varied });
             let mut method = Box::new(MethodA::new());
             let mut text = csv_header();
             text.push('\n');
