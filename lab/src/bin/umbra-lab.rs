@@ -80,6 +80,10 @@ enum Command {
         /// learns wall pieces of other thickness, reach and dropout, shelves and pillars.
         #[arg(long, default_value_t = 0.5)]
         varied: f64,
+        /// Share of a varied world's chairs drawn as office chairs (`umbra-sim dataset
+        /// --office-chairs`; 0: none, `docs/world.md` says why).
+        #[arg(long, default_value_t = 0.0)]
+        office_chairs: f64,
     },
     /// Trains the forest and writes its tables.
     ForestTrain {
@@ -259,8 +263,10 @@ fn run(cli: Cli) -> Result<(), String> {
             pose,
             clutter,
             varied,
+            office_chairs,
         } => {
-            let cfg = scene_cfg(seed, pose, Worlds { clutter, varied });
+            let mut cfg = scene_cfg(seed, pose, Worlds { clutter, varied });
+            cfg.world.office_chairs = office_chairs;
             let mut method = Box::new(MethodA::new());
             let mut text = csv_header();
             text.push('\n');

@@ -1,6 +1,6 @@
 //! `umbra-sim`: the simulator's command line.
 //!
-//! * `umbra-sim dataset --out DIR [--scenarios 50] [--frames 200] [--seed 1] [--kinds rect,lshape,tworooms] [--clutter 3] [--varied 0.5] [--test-only]`
+//! * `umbra-sim dataset --out DIR [--scenarios 50] [--frames 200] [--seed 1] [--kinds rect,lshape,tworooms] [--clutter 3] [--varied 0.5] [--office-chairs 0.4] [--test-only]`
 //!   writes the datasets of `sim::dataset` with a progress bar.
 //! * `umbra-sim speed [--scenarios 16] [--frames 200]` measures labelled frames per second
 //!   with rasters and labels built in memory.
@@ -64,6 +64,9 @@ enum Command {
         /// shelves, radiators, square pillars, a LiDAR that reaches less far.
         #[arg(long, default_value_t = 0.0)]
         varied: f64,
+        /// Share of a varied world's chairs drawn as office chairs on a five-star base (0–1).
+        #[arg(long, default_value_t = 0.0)]
+        office_chairs: f64,
         /// Skip Method B images and labels.
         #[arg(long)]
         no_images: bool,
@@ -165,6 +168,7 @@ fn run(command: Command) -> Result<(), String> {
             kinds: k,
             clutter,
             varied,
+            office_chairs,
             no_images,
             no_method_a,
             no_recordings,
@@ -180,6 +184,7 @@ fn run(command: Command) -> Result<(), String> {
                     kinds: kinds(&k),
                     max_clutter: clutter,
                     varied,
+                    office_chairs,
                     ..WorldConfig::default()
                 },
                 method_b: !no_images,

@@ -19,6 +19,17 @@ pub(super) fn rect_corners(c: Point2, half: (f32, f32), yaw: f32) -> [Point2; 4]
     ]
 }
 
+/// How a piece of furniture is built at LiDAR height.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(super) enum Build {
+    /// Four round legs of this radius at the footprint's corners (chairs, desks).
+    Legs(f32),
+    /// A solid footprint (boxes).
+    Solid,
+    /// An office chair: a gas column on a five-star base (`variety.rs`).
+    OfficeChair,
+}
+
 pub(super) struct Builder {
     pub(super) rng: ChaCha8Rng,
     pub(super) prims: Vec<Prim>,
@@ -32,6 +43,11 @@ pub(super) struct Builder {
     pub(super) wall_t: f32,
     /// Drawn with the wider variety (`variety.rs`).
     pub(super) varied: bool,
+    /// Share of chairs that are office chairs (0 unless asked for in a varied world).
+    pub(super) office_share: f64,
+    /// A second stream for the furniture styles of a varied world (`variety.rs`: office
+    /// chairs), drawn from only when they are asked for.
+    pub(super) style: ChaCha8Rng,
 }
 
 impl Builder {
@@ -265,14 +281,23 @@ impl Builder {
         )
     }
 
-    /// The half-size and leg radius (`None`: solid) of a new piece of `class`, scaled by
-    /// U(0.8, 1.2); `None` for classes that are not furniture.
-    pub(super) fn piece_shape(&mut self, class: ObjectClass) -> Option<((f32, f32), Option<f32>)> {
+    /// The half-size and build of a new piece of `class`, scaled by U(0.8, 1.2); `None` for
+    /// classes that are not furniture. A chair may be an office chair
+    /// ([`super::WorldConfig::office_chairs`]), whose half-size is its base's radius.
+    pub(super) fn piece_shape(&mut self, class: ObjectClass) -> Option<((f32, f32), Build)> {
         let scale = self.rng.random_range(0.8..1.2f32);
         match class {
-            ObjectClass::Chair => Some(((0.2 * scale, 0.2 * scale), Some(0.015 * scale))),
-            ObjectClass::Desk => Some(((0.8 * scale, 0.4 * scale), Some(0.025 * scale))),
-            ObjectClass::Box => Some(((0.3 * scale, 0.2 * scale), None)),
+            ObjectClass::Chair => {
+                let half = (0.2 * scale, 0.2 * scale);
+                if self.office_share > 0.0 && self.style.random_bool(self.office_share) {
+                    let r = super::variety::star_radius(half);
+                    Some(((r, r), Build::OfficeChair))
+                } else {
+                    Some((half, Build::Legs(0.015 * scale)))
+                }
+            }
+            ObjectClass::Desk => Some(((0.8 * scale, 0.4 * scale), Build::Legs(0.025 * scale))),
+            ObjectClass::Box => Some(((0.3 * scale, 0.2 * scale), Build::Solid)),
             ObjectClass::DoorFrame => None,
         }
     }
@@ -284,12 +309,13 @@ impl Builder {
         c: Point2,
         yaw: f32,
         half: (f32, f32),
-        leg: Option<f32>,
+        build: Build,
     ) {
         let id = Surface::Object(self.objects.len() as u16);
         let footprint = rect_corners(c, half, yaw);
-        match leg {
-            Some(r) => {
+        match build {
+            Build::OfficeChair => self.office_chair(c, yaw, half.0, id),
+            Build::Legs(r) => {
                 let refl = match class {
                     ObjectClass::Desk => self.rng.random_range(0.25..0.7),
                     _ => self.rng.random_range(0.35..0.9),
@@ -298,7 +324,7 @@ impl Builder {
                     self.circle(leg_c, r, id, refl);
                 }
             }
-            None => {
+            Build::Solid => {
                 let refl = self.rng.random_range(0.55..0.9);
                 self.polygon(&footprint, id, refl);
             }
@@ -315,7 +341,7 @@ impl Builder {
 
     /// A piece of `class` anywhere on the floor, [`CLEARANCE`] from everything else.
     pub(super) fn furniture(&mut self, class: ObjectClass) -> bool {
-        let Some((half, leg)) = self.piece_shape(class) else {
+        let Some((half, build)) = self.piece_shape(class) else {
             return false;
         };
         let radius = (half.0 * half.0 + half.1 * half.1).sqrt();
@@ -327,7 +353,7 @@ impl Builder {
             let yaw = self
                 .rng
                 .random_range(-core::f32::consts::PI..core::f32::consts::PI);
-            self.put(class, c, yaw, half, leg);
+            self.put(class, c, yaw, half, build);
             return true;
         }
         false

@@ -9,7 +9,8 @@
 //! Furniture (the study's world geometry, `docs/simulator.md`): a chair is four ~3 cm legs on a ~0.4 m square, a
 //! desk four ~5 cm legs on ~0.8 × 1.6 m, a box a solid ~0.4 × 0.6 m rectangle, each scaled by
 //! U(0.8, 1.2), placed uniformly with random rotation, no overlaps and ≥ 0.7 m between
-//! footprints. Clutter: round bins, round pillars, and pairs of people's legs.
+//! footprints (a varied world's chairs may be office chairs instead: `variety.rs`). Clutter:
+//! round bins, round pillars, and pairs of people's legs.
 //!
 //! Every surface carries a [`Surface`] label (what a ray that hits it has hit) and a
 //! reflectivity that drives the LiDAR's dropouts and intensity.
@@ -220,6 +221,9 @@ pub struct WorldConfig {
     /// pillars, and a LiDAR whose reach and dropouts vary. 0 (the default) draws nothing extra,
     /// so the worlds of every seed are the ones they always were.
     pub varied: f64,
+    /// Share of a varied world's chairs drawn as office chairs on a five-star base
+    /// (`variety.rs`). 0 (the default) draws none and leaves every world as it was.
+    pub office_chairs: f64,
 }
 
 impl Default for WorldConfig {
@@ -230,6 +234,7 @@ impl Default for WorldConfig {
             door_chance: 0.8,
             max_clutter: 3,
             varied: 0.0,
+            office_chairs: 0.0,
         }
     }
 }
@@ -278,6 +283,12 @@ impl World {
             keep_out: Vec::new(),
             wall_t,
             varied,
+            office_share: if varied {
+                cfg.office_chairs.clamp(0.0, 1.0)
+            } else {
+                0.0
+            },
+            style: ChaCha8Rng::seed_from_u64(seed ^ 0x000f_f1ce),
         };
         let door_min = if varied {
             variety::DOOR_WIDTH_MIN
