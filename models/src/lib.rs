@@ -4,6 +4,7 @@
 //!
 //! | module            | owns                                                           |
 //! |-------------------|----------------------------------------------------------------|
+//! | [`calibration`]   | the detections' score calibration (`no_std`), from [`calibration_counts`] |
 //! | [`forest`]        | the Method A classifier at run time over `const` tables (`no_std`) |
 //! | [`forest_tables`] | the trained forest, generated from `models/data/forest-train.csv` |
 //! | `train`           | the forest trainer and table emitter (`train` feature: the lab's, host only) |
@@ -13,6 +14,9 @@
 
 pub use perception::class::ObjectClass;
 
+pub mod calibration;
+#[rustfmt::skip]
+pub mod calibration_counts;
 pub mod forest;
 #[rustfmt::skip]
 pub mod forest_tables;

@@ -26,6 +26,7 @@
 //! | [`wall_piece`] | a detection whose returns lie on a line that goes on as a wall does |
 //! | [`outline`]    | a "box" whose returns lie on an arc (a bin, a round pillar) |
 //! | [`fusion`]     | one frame's objects from both methods: A's, and B's joined or added |
+//! | [`calibration`] | what a detection's score means: a measured probability per source and class |
 //! | [`sight`]      | what a revolution showed of a footprint (hidden, in view, seen empty) or a doorway |
 //! | [`motion`]     | a track's alpha–beta motion filter; walking legs told from furniture |
 //! | [`legs`]       | people's legs in a revolution: leg-sized free-standing blobs, paired |
@@ -36,6 +37,7 @@
 #![cfg_attr(not(any(test, feature = "std")), no_std)]
 #![deny(unsafe_code, missing_docs)]
 
+pub mod calibration;
 pub mod class;
 pub mod cloud;
 pub mod dbscan;

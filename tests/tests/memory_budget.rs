@@ -139,6 +139,11 @@ fn buffers_in_code() -> Vec<(&'static str, usize, usize)> {
             size_of::<perception::tracks::Track>(),
         ),
         (
+            "size_of::<perception::calibration::Calibration>()",
+            1,
+            size_of::<perception::calibration::Calibration>(),
+        ),
+        (
             "perception::tracks::MAX_WALKERS",
             perception::tracks::MAX_WALKERS,
             size_of::<perception::tracks::Walker>(),

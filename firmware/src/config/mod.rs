@@ -286,6 +286,13 @@ pub struct WorldSettings {
     /// person in `people` even when neither method took the legs for furniture. Off by
     /// default: on held-out runs it found few more people than it made up (docs/world.md).
     pub legs: bool,
+    /// Furniture whose detections were, on the whole, of the kinds that are right less often
+    /// than this is not reported: each detection's probability is how often detections of its
+    /// source, class and score stood on a piece of their class in the simulator's tuning runs
+    /// (`perception::calibration`, the counts compiled in from `models`), and a track's is
+    /// their mean (`perception::tracks::Track::likelihood`). 0 (the default): every track
+    /// that earns a report is reported. 0.6 trades recall for precision (docs/world.md).
+    pub min_likelihood: f32,
 }
 
 impl Default for WorldSettings {
@@ -296,6 +303,7 @@ impl Default for WorldSettings {
             settle_s: m.settle_s,
             people: true,
             legs: false,
+            min_likelihood: 0.0,
         }
     }
 }
@@ -313,6 +321,10 @@ impl WorldSettings {
             c.motion.moving_m = f32::INFINITY;
         }
         c.walkers = self.people && self.legs;
+        c.calibration = models::calibration::calibration();
+        if self.min_likelihood.is_finite() {
+            c.min_likelihood = self.min_likelihood.clamp(0.0, 1.0);
+        }
         c
     }
 }
@@ -447,6 +459,13 @@ impl Config {
                 l.stale_after_ms
             ));
         }
+        within(
+            "world",
+            "min_likelihood",
+            self.world.min_likelihood,
+            0.0,
+            1.0,
+        )?;
         let a = &self.method_a;
         let within = |name: &str, v: f32, lo: f32, hi: f32| within("method_a", name, v, lo, hi);
         within("drop_fraction", a.drop_fraction, 0.0, 1.0)?;
@@ -584,6 +603,18 @@ mod test {
                 .unwrap_err()
                 .contains("method_a.door_max_gap_m")
         );
+        let bad: Config = toml::from_str("[world]\nmin_likelihood = 1.5\n").unwrap();
+        assert!(bad.validate().unwrap_err().contains("world.min_likelihood"));
+        // Set, it reaches the track table with the compiled-in calibration; unset, nothing is
+        // held back.
+        let w: Config = toml::from_str("[world]\nmin_likelihood = 0.6\n").unwrap();
+        let t = w.world.tracks();
+        assert_eq!(t.min_likelihood, 0.6);
+        assert_ne!(
+            t.calibration,
+            perception::calibration::Calibration::IDENTITY
+        );
+        assert_eq!(Config::default().world.tracks().min_likelihood, 0.0);
         let bad: Config = toml::from_str("[method_b]\nconf = 1.5\n").unwrap();
         assert!(bad.validate().unwrap_err().contains("method_b.conf"));
         let bad: Config = toml::from_str("[method_b]\nthreads = 0\n").unwrap();

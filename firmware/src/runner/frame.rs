@@ -444,6 +444,10 @@ impl<S: RevolutionStream> FrameLoop<'_, S> {
                 if t.too_narrow() {
                     continue;
                 }
+                // Furniture seen only in the ways the methods are mostly wrong.
+                if t.unlikely(cfg) {
+                    continue;
+                }
                 let o = ObjectOut::track(t);
                 if t.class() == ObjectClass::DoorFrame && t.width_m > 0.0 {
                     push_door(

@@ -85,6 +85,19 @@ enum Command {
         #[arg(long, default_value_t = 0.0)]
         office_chairs: f64,
     },
+    /// Writes the detections' score calibration (`models/src/calibration_counts.rs`) from
+    /// `eval-world --json` files: each file's families' detection counts by source, class and
+    /// tenth of the score, summed. Fit it on tuning seeds only (`docs/world.md`).
+    Calibrate {
+        /// `eval-world --json` outputs.
+        #[arg(required = true)]
+        json: Vec<PathBuf>,
+        #[arg(long, default_value = "models/src/calibration_counts.rs")]
+        out: PathBuf,
+        /// The command that made the JSON files, recorded in the table's header.
+        #[arg(long, default_value = "")]
+        made_by: String,
+    },
     /// Trains the forest and writes its tables.
     ForestTrain {
         #[arg(long, default_value = "models/data/forest-train.csv")]
@@ -295,6 +308,11 @@ fn run(cli: Cli) -> Result<(), String> {
             }
             std::fs::write(&out, text).map_err(|e| format!("{}: {e}", out.display()))?;
             println!("{}: {counts:?}", out.display());
+        }
+        Command::Calibrate { json, out, made_by } => {
+            let text = lab::world_eval::calibration_counts(&json, &made_by)?;
+            std::fs::write(&out, text).map_err(|e| format!("{}: {e}", out.display()))?;
+            println!("{}", out.display());
         }
         Command::ForestTrain {
             data,

@@ -15,7 +15,7 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 
 use crate::annex::{self, GeneratedRun};
-use score::{CLASSES, Line, Tally, ratio, score_run};
+use score::{CLASSES, Line, SCORE_BINS, Tally, ratio, score_run};
 
 /// A scene family.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -342,6 +342,7 @@ pub fn report(outcomes: &[Outcome]) -> String {
                 "  phantoms/frame among detections {}",
                 ph(&t.det_phantoms, f64::from(t.det_frames))
             );
+            reliability_lines(&mut s, &t.reliability);
         }
         let _ = writeln!(
             s,
@@ -400,4 +401,107 @@ pub fn report(outcomes: &[Outcome]) -> String {
         }
     }
     s
+}
+
+/// The detections' reliability: for each source and class with any, the share of each tenth
+/// of the score that stood on a piece of its class (`true/n`), and the mean score against
+/// that share over all of them (a calibrated score has the two equal).
+fn reliability_lines(s: &mut String, rel: &[u32]) {
+    if rel.len() < score::RELIABILITY_LEN {
+        return;
+    }
+    let _ = writeln!(
+        s,
+        "  detections' scores against how often they came true (score tenth: true/n):"
+    );
+    for (src, name) in ["A", "B", "AB"].iter().enumerate() {
+        for (c, class) in ["chair", "box", "desk", "door frame"].iter().enumerate() {
+            let at = |bin: usize| ((src * 4 + c) * SCORE_BINS + bin) * 2;
+            let (n, ok): (u32, u32) =
+                (0..SCORE_BINS).fold((0, 0), |(n, ok), b| (n + rel[at(b)], ok + rel[at(b) + 1]));
+            if n == 0 {
+                continue;
+            }
+            let bins: Vec<String> = (0..SCORE_BINS)
+                .filter(|&b| rel[at(b)] > 0)
+                .map(|b| format!("{:.1}: {}/{}", b as f64 / 10.0, rel[at(b) + 1], rel[at(b)]))
+                .collect();
+            let _ = writeln!(
+                s,
+                "    {name} {class}: {} true of {n}; {}",
+                pct(ratio(ok, n)),
+                bins.join(", ")
+            );
+        }
+    }
+}
+
+/// The Rust source of `models/src/calibration_counts.rs` from `eval-world --json` files: the
+/// sum of every family's detection reliability counts ([`Tally::reliability`]).
+pub fn calibration_counts(files: &[PathBuf], made_by: &str) -> Result<String, String> {
+    let mut sum = vec![0u32; score::RELIABILITY_LEN];
+    let mut names = Vec::new();
+    for f in files {
+        let text = std::fs::read_to_string(f).map_err(|e| format!("{}: {e}", f.display()))?;
+        let v: serde_json::Value =
+            serde_json::from_str(&text).map_err(|e| format!("{}: {e}", f.display()))?;
+        let families = v
+            .as_array()
+            .ok_or_else(|| format!("{}: not an eval-world --json file", f.display()))?;
+        for fam in families {
+            let rel: Vec<u32> = fam
+                .get("tally")
+                .and_then(|t| t.get("reliability"))
+                .and_then(|r| serde_json::from_value(r.clone()).ok())
+                .unwrap_or_default();
+            if rel.len() == sum.len() {
+                for (a, b) in sum.iter_mut().zip(&rel) {
+                    *a += b;
+                }
+            }
+        }
+        names.push(
+            f.file_name()
+                .map_or_else(String::new, |n| n.to_string_lossy().into_owned()),
+        );
+    }
+    if sum.iter().all(|&n| n == 0) {
+        return Err(
+            "no detection counts in those files (eval-world with the world model on writes them)"
+                .into(),
+        );
+    }
+    let mut s = String::new();
+    let _ = writeln!(
+        s,
+        "//! Detection counts the score calibration is fitted from. Generated; do not edit."
+    );
+    let _ = writeln!(s, "//!");
+    let _ = writeln!(
+        s,
+        "//! `umbra-lab calibrate {}` after `{}`.",
+        names.join(" "),
+        if made_by.is_empty() {
+            "eval-world --json"
+        } else {
+            made_by
+        }
+    );
+    let _ = writeln!(
+        s,
+        "//! Per source (A, B, AB), class (chair, box, desk, door frame) and tenth of the score:"
+    );
+    let _ = writeln!(s, "//! `[detections, on a piece of their class]`.");
+    let _ = writeln!(s);
+    let _ = writeln!(
+        s,
+        "/// The counts, laid out as `perception::calibration::COUNTS_LEN` says."
+    );
+    let _ = writeln!(s, "pub const COUNTS: [u32; {}] = [", sum.len());
+    for row in sum.chunks(score::SCORE_BINS * 2) {
+        let cells: Vec<String> = row.iter().map(u32::to_string).collect();
+        let _ = writeln!(s, "    {},", cells.join(", "));
+    }
+    let _ = writeln!(s, "];");
+    Ok(s)
 }

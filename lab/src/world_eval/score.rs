@@ -44,6 +44,8 @@ pub struct Reported {
     pub at: Point2,
     /// `source`: 0 = A, 1 = B, 2 = AB.
     pub source: usize,
+    /// `score` (NaN when the line has none).
+    pub score: f32,
 }
 
 /// One output line, as far as the scorer reads it.
@@ -82,6 +84,7 @@ fn objects(v: Option<&Value>) -> Option<Vec<Reported>> {
                         Some("B") => 1,
                         _ => 2,
                     },
+                    score: o.get("score").and_then(Value::as_f64).unwrap_or(f64::NAN) as f32,
                 })
             })
             .collect(),
@@ -203,9 +206,32 @@ pub struct Tally {
     /// Each run's position error at its last scored frame, m.
     #[serde(default)]
     pub final_position_err_m: Vec<f64>,
+    /// How often a detection's score came true: for each source (A, B, AB), class (chair, box,
+    /// desk, door frame) and tenth of the score, the detections and how many of them stood
+    /// on a piece of their class (a door frame: on a door), `[n, true]` pairs in that order
+    /// ([`reliability_index`]); empty until a detection was scored.
+    #[serde(default)]
+    pub reliability: Vec<u32>,
     /// The reports on walking people, one line each (frame, id, class, source), for reading.
     #[serde(skip)]
     pub people_reports: Vec<String>,
+}
+
+/// Score bins of [`Tally::reliability`]: the calibration's tenths.
+pub const SCORE_BINS: usize = perception::calibration::SCORE_BINS;
+
+/// Length of [`Tally::reliability`]: 3 sources × 4 classes × [`SCORE_BINS`] × `[n, true]`,
+/// the layout `perception::calibration::Calibration::fit` reads.
+pub const RELIABILITY_LEN: usize = perception::calibration::COUNTS_LEN;
+
+/// Where a detection of `source` and `class` with `score` is counted in
+/// [`Tally::reliability`] (its `n`; `true` follows); None for a score that is not a number.
+pub fn reliability_index(source: usize, class: ObjectClass, score: f32) -> Option<usize> {
+    if !score.is_finite() {
+        return None;
+    }
+    let bin = ((score.clamp(0.0, 1.0) * SCORE_BINS as f32) as usize).min(SCORE_BINS - 1);
+    Some(((source.min(2) * 4 + class as usize) * SCORE_BINS + bin) * 2)
 }
 
 /// Class names of the tally's per-class arrays.
@@ -295,6 +321,23 @@ pub fn score_run(truth: &RunTruth, lines: &[Line], tally: &mut Tally) {
         }
         let mut tally_objects = |objs: &[Reported], phantoms: &mut [u32; 3], main: bool| {
             for o in objs {
+                if !main && let Some(c) = o.class {
+                    let right = if c == ObjectClass::DoorFrame {
+                        truth
+                            .doors
+                            .iter()
+                            .any(|d| d.centre.distance(o.at) <= DOOR_MATCH_M)
+                    } else {
+                        on_furniture(&alive, o.at).any(|f| f.class == c)
+                    };
+                    if let Some(k) = reliability_index(o.source, c, o.score) {
+                        if tally.reliability.len() < RELIABILITY_LEN {
+                            tally.reliability.resize(RELIABILITY_LEN, 0);
+                        }
+                        tally.reliability[k] += 1;
+                        tally.reliability[k + 1] += u32::from(right);
+                    }
+                }
                 match o.class {
                     Some(ObjectClass::DoorFrame) => {
                         if !truth
@@ -575,6 +618,12 @@ impl Tally {
             .extend_from_slice(&o.final_position_err_m);
         self.move_gone_s.extend_from_slice(&o.move_gone_s);
         self.people_reports.extend_from_slice(&o.people_reports);
+        if self.reliability.len() < o.reliability.len() {
+            self.reliability.resize(o.reliability.len(), 0);
+        }
+        for (a, b) in self.reliability.iter_mut().zip(&o.reliability) {
+            *a += b;
+        }
     }
 
     /// IDF1 = 2·IDTP / (GT + reported).
@@ -647,6 +696,7 @@ mod test {
             class: Some(class),
             at: Point2::new(x, y),
             source: 2,
+            score: 0.9,
         }
     }
 
@@ -755,10 +805,12 @@ mod test {
                 objects: vec![
                     Reported {
                         source: 0,
+                        score: 0.9,
                         ..obj(3, ObjectClass::Desk, 1.0, 0.0)
                     },
                     Reported {
                         source: 1,
+                        score: 0.9,
                         ..obj(4, ObjectClass::Box, 3.0, 3.0)
                     },
                     obj(5, ObjectClass::Box, -1.0, 0.0),
@@ -776,6 +828,39 @@ mod test {
         assert_eq!(s.map_tp, [0, 0, 0]);
         assert_eq!(s.map_visible, [1, 0, 0]);
         assert_eq!(s.map_reported, [0, 2, 1]);
+    }
+
+    #[test]
+    fn detections_are_counted_by_source_class_and_score_with_whether_they_came_true() {
+        let t = truth();
+        let det = |source, class, x, y, score| Reported {
+            source,
+            score,
+            ..obj(u64::MAX, class, x, y)
+        };
+        let line = Line {
+            detections: Some(vec![
+                // Method B: a chair on the chair, a box on the chair (wrong class), a box on
+                // nothing; both methods: a door frame on the door; a score that is no number.
+                det(1, ObjectClass::Chair, 1.05, 0.0, 0.72),
+                det(1, ObjectClass::Box, 1.0, 0.1, 0.31),
+                det(1, ObjectClass::Box, 3.0, 3.0, 0.35),
+                det(2, ObjectClass::DoorFrame, 0.1, 2.0, 1.0),
+                det(0, ObjectClass::Desk, 1.0, 0.0, f32::NAN),
+            ]),
+            ..Line::default()
+        };
+        let mut s = Tally::default();
+        score_run(&t, &[line], &mut s);
+        assert_eq!(s.reliability.len(), RELIABILITY_LEN);
+        let at = |src, c, score| reliability_index(src, c, score).unwrap();
+        let pair = |k: usize| [s.reliability[k], s.reliability[k + 1]];
+        assert_eq!(pair(at(1, ObjectClass::Chair, 0.72)), [1, 1]);
+        assert_eq!(pair(at(1, ObjectClass::Box, 0.3)), [2, 0]);
+        // A score of 1 is in the top tenth.
+        assert_eq!(pair(at(2, ObjectClass::DoorFrame, 0.95)), [1, 1]);
+        assert_eq!(s.reliability.iter().step_by(2).sum::<u32>(), 4);
+        assert!(reliability_index(0, ObjectClass::Desk, f32::NAN).is_none());
     }
 
     #[test]
@@ -835,7 +920,7 @@ mod test {
                     match v {
                         serde_json::Value::Number(_) => *v = x.into(),
                         serde_json::Value::Array(a) if a.is_empty() => {
-                            *v = vec![f64::from(x)].into()
+                            *v = vec![serde_json::Value::from(x)].into()
                         }
                         serde_json::Value::Array(a) => a.iter_mut().for_each(|e| *e = x.into()),
                         _ => {}
@@ -884,7 +969,8 @@ mod test {
                 id: 4,
                 class: Some(ObjectClass::Chair),
                 at: Point2::new(1.0, 2.0),
-                source: 1
+                source: 1,
+                score: 0.9
             }]
         );
         assert_eq!(l.doors, vec![Point2::new(0.5, 0.1)]);

@@ -36,6 +36,7 @@
 
 use heapless::Vec;
 
+use crate::calibration::Calibration;
 use crate::class::ObjectClass;
 use crate::fusion::{Evidence, FrameObject};
 use crate::geometry::{Point2, Pose2};
@@ -104,6 +105,12 @@ pub struct TrackConfig {
     pub motion: MotionConfig,
     /// Track the leg detector's person candidates ([`Tracks::update_walkers`]).
     pub walkers: bool,
+    /// What each observation's score means ([`Calibration::probability`]): the weight of
+    /// its hit and its class evidence.
+    pub calibration: Calibration,
+    /// Furniture tracks whose observations' mean probability is below this are not reported
+    /// ([`Track::unlikely`]); 0: all are.
+    pub min_likelihood: f32,
 }
 
 impl Default for TrackConfig {
@@ -126,6 +133,8 @@ impl Default for TrackConfig {
             max_observation_m: 12.0,
             motion: MotionConfig::default(),
             walkers: true,
+            calibration: Calibration::IDENTITY,
+            min_likelihood: 0.0,
         }
     }
 }
@@ -174,6 +183,9 @@ pub struct Track {
     pub narrow_views: u16,
     /// A door frame at a corner of the map's walls ([`Tracks::mark_corner_doors`]).
     pub at_corner: bool,
+    /// Sum of its observations' probabilities ([`TrackConfig::calibration`]); over its hits,
+    /// how likely what the methods saw there was right ([`Track::likelihood`]).
+    pub p_sum: f32,
 }
 
 impl Track {
@@ -215,6 +227,23 @@ impl Track {
         self.class() == ObjectClass::Box
             && self.box_wide_views == 0
             && self.narrow_views >= NARROW_VIEWS
+    }
+
+    /// The mean probability of its observations (0 before the first): how often the
+    /// methods' detections like these stood on a piece of their class.
+    pub fn likelihood(&self) -> f32 {
+        if self.hits == 0 {
+            0.0
+        } else {
+            self.p_sum / self.hits as f32
+        }
+    }
+
+    /// A piece of furniture whose observations were, on the whole, the kind that is wrong more
+    /// often than [`TrackConfig::min_likelihood`] allows: not reported while so. Door frames
+    /// are judged by the map's walls instead ([`Track::door_at_corner`]).
+    pub fn unlikely(&self, cfg: &TrackConfig) -> bool {
+        self.class() != ObjectClass::DoorFrame && self.likelihood() < cfg.min_likelihood
     }
 
     /// A door frame only Method B has seen, not in a doorway of the map's walls, at a corner
@@ -482,6 +511,7 @@ impl Tracks {
                 box_wide_views: 0,
                 narrow_views: 0,
                 at_corner: false,
+                p_sum: 0.0,
             };
             Self::hit(&mut t, o, frame, stamp_s, cfg);
             if self.tracks.push(t).is_ok() {
@@ -497,6 +527,10 @@ impl Tracks {
             let may_move = legs(o.class) && legs(t.class());
             t.motion.observe(o.centre, stamp_s, &cfg.motion, may_move);
         }
+        let p = cfg
+            .calibration
+            .probability(o.evidence, o.class, o.score)
+            .clamp(0.0, 1.0);
         let w = o.score.clamp(0.05, 1.0);
         let total = t.weight + w;
         t.centre = Point2::new(
@@ -505,6 +539,7 @@ impl Tracks {
         );
         t.weight = total.min(cfg.max_weight);
         t.class_evidence[o.class as usize] += o.score.clamp(0.0, 1.0);
+        t.p_sum += p;
         t.existence = (t.existence + cfg.hit_gain * w).min(cfg.existence_cap);
         t.hits = t.hits.saturating_add(1);
         t.views = t.views.saturating_add(1);
@@ -639,6 +674,69 @@ mod test {
     }
 
     const CHAIR: ObjectClass = ObjectClass::Chair;
+
+    #[test]
+    fn furniture_seen_only_in_ways_that_are_mostly_wrong_is_unlikely() {
+        // Method B's boxes at 0.5 stood on a box 2 times in 10; what both methods agreed on,
+        // and Method B's door frames at 0.5, 9 in 10.
+        let mut counts = [0u32; crate::calibration::COUNTS_LEN];
+        let mut set = |source: usize, class: ObjectClass, bin: usize, n: u32, t: u32| {
+            let at = ((source * 4 + class as usize) * crate::calibration::SCORE_BINS + bin) * 2;
+            counts[at] = n;
+            counts[at + 1] = t;
+        };
+        set(1, ObjectClass::Box, 5, 100, 20);
+        set(2, ObjectClass::Box, 5, 100, 90);
+        set(1, ObjectClass::DoorFrame, 5, 100, 20);
+        let cfg = TrackConfig {
+            calibration: Calibration::fit(&counts),
+            min_likelihood: 0.6,
+            ..quick()
+        };
+        let far = ranges(4.0);
+        let run = |o: FrameObject| {
+            let mut t = Tracks::new();
+            for f in 0..12 {
+                step(&mut t, f, &[o], &Pose2::IDENTITY, &far, &cfg);
+            }
+            *t.confirmed().next().expect("confirmed")
+        };
+        let b = run(obs(ObjectClass::Box, 2.0, 0.0, 0.55, Evidence::B));
+        assert!((b.likelihood() - 21.0 / 102.0).abs() < 1e-3, "{b:?}");
+        assert!(b.unlikely(&cfg));
+        let ab = run(obs(ObjectClass::Box, 2.0, 0.0, 0.55, Evidence::AB));
+        assert!(!ab.unlikely(&cfg), "{ab:?}");
+        // Door frames are judged by the map's walls, not by this.
+        let door = run(obs(ObjectClass::DoorFrame, 2.0, 0.0, 0.55, Evidence::B));
+        assert!(door.likelihood() < 0.6 && !door.unlikely(&cfg), "{door:?}");
+        // Without calibration the scores stand: a 0.55 box is below 0.6 too, and 0 keeps all.
+        let plain = TrackConfig {
+            min_likelihood: 0.0,
+            ..cfg
+        };
+        assert!(!b.unlikely(&plain));
+        // Merged tracks keep the sum over both.
+        let mut t = Tracks::new();
+        let a = obs(ObjectClass::Box, 2.0, 0.0, 0.55, Evidence::B);
+        let c = obs(ObjectClass::Box, 2.3, 0.0, 0.55, Evidence::AB);
+        step(&mut t, 0, &[a], &Pose2::IDENTITY, &far, &cfg);
+        step(
+            &mut t,
+            1,
+            &[c],
+            &Pose2::IDENTITY,
+            &far,
+            &TrackConfig { gate_m: 0.1, ..cfg },
+        );
+        // New tracks join the table after the merge pass: the next frame merges them.
+        step(&mut t, 2, &[], &Pose2::IDENTITY, &far, &cfg);
+        assert_eq!(t.all().len(), 1, "merged");
+        let m = t.all()[0];
+        assert!(
+            (m.likelihood() - (21.0 / 102.0 + 91.0 / 102.0) / 2.0).abs() < 1e-3,
+            "{m:?}"
+        );
+    }
 
     #[test]
     fn a_box_as_narrow_as_a_post_is_not_reported_until_seen_box_wide() {
