@@ -111,6 +111,8 @@ pub struct TrackConfig {
     /// Furniture tracks whose observations' mean probability is below this are not reported
     /// ([`Track::unlikely`]); 0: all are.
     pub min_likelihood: f32,
+    /// The same for desks alone (the larger of the two applies to them).
+    pub min_desk_likelihood: f32,
 }
 
 impl Default for TrackConfig {
@@ -135,6 +137,7 @@ impl Default for TrackConfig {
             walkers: true,
             calibration: Calibration::IDENTITY,
             min_likelihood: 0.0,
+            min_desk_likelihood: 0.0,
         }
     }
 }
@@ -240,10 +243,16 @@ impl Track {
     }
 
     /// A piece of furniture whose observations were, on the whole, the kind that is wrong more
-    /// often than [`TrackConfig::min_likelihood`] allows: not reported while so. Door frames
-    /// are judged by the map's walls instead ([`Track::door_at_corner`]).
+    /// often than [`TrackConfig::min_likelihood`] allows (desks: or
+    /// [`TrackConfig::min_desk_likelihood`]): not reported while so. Door frames are judged by
+    /// the map's walls instead ([`Track::door_at_corner`]).
     pub fn unlikely(&self, cfg: &TrackConfig) -> bool {
-        self.class() != ObjectClass::DoorFrame && self.likelihood() < cfg.min_likelihood
+        let least = match self.class() {
+            ObjectClass::DoorFrame => return false,
+            ObjectClass::Desk => cfg.min_likelihood.max(cfg.min_desk_likelihood),
+            _ => cfg.min_likelihood,
+        };
+        self.likelihood() < least
     }
 
     /// A door frame only Method B has seen, not in a doorway of the map's walls, at a corner
@@ -709,12 +718,22 @@ mod test {
         // Door frames are judged by the map's walls, not by this.
         let door = run(obs(ObjectClass::DoorFrame, 2.0, 0.0, 0.55, Evidence::B));
         assert!(door.likelihood() < 0.6 && !door.unlikely(&cfg), "{door:?}");
-        // Without calibration the scores stand: a 0.55 box is below 0.6 too, and 0 keeps all.
+        // 0 keeps all.
         let plain = TrackConfig {
             min_likelihood: 0.0,
             ..cfg
         };
         assert!(!b.unlikely(&plain));
+        // The desks' own threshold is for desks alone (a class without counts: its score
+        // stands).
+        let desks_only = TrackConfig {
+            min_desk_likelihood: 0.6,
+            ..plain
+        };
+        assert!(!b.unlikely(&desks_only));
+        let desk = run(obs(ObjectClass::Desk, 2.0, 0.0, 0.3, Evidence::A));
+        assert!(desk.likelihood() < 0.6, "{desk:?}");
+        assert!(desk.unlikely(&desks_only) && !desk.unlikely(&plain));
         // Merged tracks keep the sum over both.
         let mut t = Tracks::new();
         let a = obs(ObjectClass::Box, 2.0, 0.0, 0.55, Evidence::B);
