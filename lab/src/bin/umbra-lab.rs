@@ -84,6 +84,10 @@ enum Command {
         /// --office-chairs`; 0: none, `docs/world.md` says why).
         #[arg(long, default_value_t = 0.0)]
         office_chairs: f64,
+        /// Share of a varied world's desks drawn as round tables (`umbra-sim dataset
+        /// --round-tables`; 0: none).
+        #[arg(long, default_value_t = 0.0)]
+        round_tables: f64,
     },
     /// Writes the detections' score calibration (`models/src/calibration_counts.rs`) from
     /// `eval-world --json` files: each file's families' detection counts by source, class and
@@ -277,9 +281,11 @@ fn run(cli: Cli) -> Result<(), String> {
             clutter,
             varied,
             office_chairs,
+            round_tables,
         } => {
             let mut cfg = scene_cfg(seed, pose, Worlds { clutter, varied });
             cfg.world.office_chairs = office_chairs;
+            cfg.world.round_tables = round_tables;
             let mut method = Box::new(MethodA::new());
             let mut text = csv_header();
             text.push('\n');

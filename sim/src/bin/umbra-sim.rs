@@ -1,6 +1,6 @@
 //! `umbra-sim`: the simulator's command line.
 //!
-//! * `umbra-sim dataset --out DIR [--scenarios 50] [--frames 200] [--seed 1] [--kinds rect,lshape,tworooms] [--clutter 3] [--varied 0.5] [--office-chairs 0.4] [--test-only]`
+//! * `umbra-sim dataset --out DIR [--scenarios 50] [--frames 200] [--seed 1] [--kinds rect,lshape,tworooms] [--clutter 3] [--varied 0.5] [--office-chairs 0.4] [--round-tables 0.4] [--test-only]`
 //!   writes the datasets of `sim::dataset` with a progress bar.
 //! * `umbra-sim speed [--scenarios 16] [--frames 200]` measures labelled frames per second
 //!   with rasters and labels built in memory.
@@ -67,6 +67,9 @@ enum Command {
         /// Share of a varied world's chairs drawn as office chairs on a five-star base (0–1).
         #[arg(long, default_value_t = 0.0)]
         office_chairs: f64,
+        /// Share of a varied world's desks drawn as round tables on three or four legs (0–1).
+        #[arg(long, default_value_t = 0.0)]
+        round_tables: f64,
         /// Skip Method B images and labels.
         #[arg(long)]
         no_images: bool,
@@ -169,6 +172,7 @@ fn run(command: Command) -> Result<(), String> {
             clutter,
             varied,
             office_chairs,
+            round_tables,
             no_images,
             no_method_a,
             no_recordings,
@@ -185,6 +189,7 @@ fn run(command: Command) -> Result<(), String> {
                     max_clutter: clutter,
                     varied,
                     office_chairs,
+                    round_tables,
                     ..WorldConfig::default()
                 },
                 method_b: !no_images,

@@ -28,6 +28,8 @@ pub(super) enum Build {
     Solid,
     /// An office chair: a gas column on a five-star base (`variety.rs`).
     OfficeChair,
+    /// A round table: three or four legs on a circle under its top (`variety.rs`).
+    RoundTable,
 }
 
 pub(super) struct Builder {
@@ -45,8 +47,10 @@ pub(super) struct Builder {
     pub(super) varied: bool,
     /// Share of chairs that are office chairs (0 unless asked for in a varied world).
     pub(super) office_share: f64,
+    /// Share of desks that are round tables (0 unless asked for in a varied world).
+    pub(super) round_share: f64,
     /// A second stream for the furniture styles of a varied world (`variety.rs`: office
-    /// chairs), drawn from only when they are asked for.
+    /// chairs, round tables), drawn from only when they are asked for.
     pub(super) style: ChaCha8Rng,
 }
 
@@ -283,7 +287,8 @@ impl Builder {
 
     /// The half-size and build of a new piece of `class`, scaled by U(0.8, 1.2); `None` for
     /// classes that are not furniture. A chair may be an office chair
-    /// ([`super::WorldConfig::office_chairs`]), whose half-size is its base's radius.
+    /// ([`super::WorldConfig::office_chairs`]), whose half-size is its base's radius, and a
+    /// desk a round table ([`super::WorldConfig::round_tables`]), whose half-size is its top's.
     pub(super) fn piece_shape(&mut self, class: ObjectClass) -> Option<((f32, f32), Build)> {
         let scale = self.rng.random_range(0.8..1.2f32);
         match class {
@@ -296,7 +301,14 @@ impl Builder {
                     Some((half, Build::Legs(0.015 * scale)))
                 }
             }
-            ObjectClass::Desk => Some(((0.8 * scale, 0.4 * scale), Build::Legs(0.025 * scale))),
+            ObjectClass::Desk => {
+                if self.round_share > 0.0 && self.style.random_bool(self.round_share) {
+                    let r = super::variety::round_top_radius(scale);
+                    Some(((r, r), Build::RoundTable))
+                } else {
+                    Some(((0.8 * scale, 0.4 * scale), Build::Legs(0.025 * scale)))
+                }
+            }
             ObjectClass::Box => Some(((0.3 * scale, 0.2 * scale), Build::Solid)),
             ObjectClass::DoorFrame => None,
         }
@@ -315,6 +327,7 @@ impl Builder {
         let footprint = rect_corners(c, half, yaw);
         match build {
             Build::OfficeChair => self.office_chair(c, yaw, half.0, id),
+            Build::RoundTable => self.round_table(c, yaw, half.0, id),
             Build::Legs(r) => {
                 let refl = match class {
                     ObjectClass::Desk => self.rng.random_range(0.25..0.7),

@@ -224,6 +224,9 @@ pub struct WorldConfig {
     /// Share of a varied world's chairs drawn as office chairs on a five-star base
     /// (`variety.rs`). 0 (the default) draws none and leaves every world as it was.
     pub office_chairs: f64,
+    /// Share of a varied world's desks drawn as round tables on three or four legs
+    /// (`variety.rs`). 0 (the default) draws none and leaves every world as it was.
+    pub round_tables: f64,
 }
 
 impl Default for WorldConfig {
@@ -235,6 +238,7 @@ impl Default for WorldConfig {
             max_clutter: 3,
             varied: 0.0,
             office_chairs: 0.0,
+            round_tables: 0.0,
         }
     }
 }
@@ -285,6 +289,11 @@ impl World {
             varied,
             office_share: if varied {
                 cfg.office_chairs.clamp(0.0, 1.0)
+            } else {
+                0.0
+            },
+            round_share: if varied {
+                cfg.round_tables.clamp(0.0, 1.0)
             } else {
                 0.0
             },

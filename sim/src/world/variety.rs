@@ -13,7 +13,11 @@
 //!   default) on a five-star base 0.5–0.7 m across:
 //!   at LiDAR height a scan cuts the gas column (5–8 cm) and the base's five arms at one
 //!   radius, where they rise through the scan plane from the casters to the hub. Drawn from
-//!   the world's own `style` stream.
+//!   the world's own `style` stream;
+//! * round tables on request ([`super::WorldConfig::round_tables`] of the desks; none by
+//!   default), 0.7–1.1 m across on three or four legs (2–5 cm) set 5–12 cm in from the top's
+//!   edge. A pedestal table would show its column alone at LiDAR height, a post like any
+//!   other (the office chair's lesson): not drawn. From the `style` stream too.
 //!
 //! Wall thickness (0.05–0.25 m) and reflectivity (0.12–1.0) are drawn in `build.rs`; the
 //! LiDAR's reach and dropouts in `Lds01SimConfig::varied`. Everything here draws from the
@@ -38,6 +42,11 @@ const WALL_SIDE_GAP: f32 = 0.35;
 /// m, the 0.5–0.7 m bases office chairs stand on.
 pub(super) fn star_radius(half: (f32, f32)) -> f32 {
     (half.0.max(half.1) * 1.45).clamp(0.25, 0.35)
+}
+
+/// The top's radius of a round table drawn at `scale` (0.8–1.2): 0.35–0.55 m.
+pub(super) fn round_top_radius(scale: f32) -> f32 {
+    (0.45 * scale).clamp(0.35, 0.55)
 }
 
 /// A spot against a wall: the centre and yaw of a rectangle with half-sizes `half` whose
@@ -179,6 +188,20 @@ impl Builder {
             let a = yaw + k as f32 * (2.0 * PI / 5.0);
             let p = Point2::new(c.x + cut * a.cos(), c.y + cut * a.sin());
             self.circle(p, arm, id, refl);
+        }
+    }
+
+    /// A round table at `c` whose top has radius `radius`: three or four legs evenly round a
+    /// circle 5–12 cm inside the top's edge, the first at `yaw`.
+    pub(super) fn round_table(&mut self, c: Point2, yaw: f32, radius: f32, id: Surface) {
+        let legs = if self.style.random_bool(0.5) { 3 } else { 4 };
+        let leg = self.style.random_range(0.012..0.025f32);
+        let at = radius - self.style.random_range(0.05..0.12f32);
+        let refl = self.style.random_range(0.25..0.8f32);
+        for k in 0..legs {
+            let a = yaw + k as f32 * (2.0 * PI / legs as f32);
+            let p = Point2::new(c.x + at * a.cos(), c.y + at * a.sin());
+            self.circle(p, leg, id, refl);
         }
     }
 
@@ -552,6 +575,59 @@ mod test {
         assert!(
             office_chairs * 5 >= chairs && office_chairs * 5 <= chairs * 3,
             "{office_chairs} office chairs of {chairs}"
+        );
+    }
+
+    #[test]
+    fn round_tables_stand_on_three_or_four_legs_in_varied_worlds_when_asked() {
+        let round = WorldConfig {
+            round_tables: 0.5,
+            ..varied()
+        };
+        let (mut desks, mut tables) = (0, 0);
+        for seed in 0..80 {
+            let w = World::generate(seed, &round);
+            for (i, o) in w.objects.iter().enumerate() {
+                if o.class != ObjectClass::Desk {
+                    continue;
+                }
+                desks += 1;
+                let legs = circles(&w, i);
+                let d: Vec<f32> = legs.iter().map(|l| l.0.distance(o.centre)).collect();
+                let (w0, w1) = (
+                    o.footprint[0].distance(o.footprint[1]),
+                    o.footprint[1].distance(o.footprint[2]),
+                );
+                if (w0 - w1).abs() < 1e-3 {
+                    // A round table: its legs on one circle inside the top, evenly spaced.
+                    assert!(matches!(legs.len(), 3 | 4), "seed {seed}: {legs:?}");
+                    let top = w0 / 2.0;
+                    assert!((0.35..=0.55).contains(&top), "seed {seed}: top {top}");
+                    for (k, l) in legs.iter().enumerate() {
+                        assert!((d[k] - d[0]).abs() < 1e-3 && d[0] < top - 0.04);
+                        assert!((0.012..0.025).contains(&l.1));
+                        let next = legs[(k + 1) % legs.len()].0;
+                        let chord = 2.0 * d[0] * (PI / legs.len() as f32).sin();
+                        assert!((l.0.distance(next) - chord).abs() < 1e-3);
+                    }
+                    tables += 1;
+                } else {
+                    assert_eq!(legs.len(), 4, "seed {seed}: a desk's four legs");
+                }
+            }
+            // Asked for in a world drawn without variety: the world is the one it always was.
+            let study = WorldConfig {
+                round_tables: 0.5,
+                ..WorldConfig::default()
+            };
+            assert_eq!(
+                World::generate(seed, &study).prims,
+                World::generate(seed, &WorldConfig::default()).prims
+            );
+        }
+        assert!(
+            tables * 4 >= desks && tables * 4 <= desks * 3,
+            "{tables} round tables of {desks} desks"
         );
     }
 }
