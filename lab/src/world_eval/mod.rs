@@ -6,7 +6,10 @@
 //! through the `umbra` binary itself (`umbra replay CAPTURE --odom TICKS --jsonl -`), with the
 //! world model on or off; the output lines are scored by [`score`].
 
+mod assignment;
 pub mod picture;
+mod places;
+pub mod reliability;
 pub mod score;
 pub mod sim_family;
 
@@ -15,7 +18,8 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 
 use crate::annex::{self, GeneratedRun};
-use score::{CLASSES, Line, SCORE_BINS, Tally, ratio, score_run};
+use reliability::{RELIABILITY_LEN, SCORE_BINS};
+use score::{CLASSES, Line, Tally, ratio, score_run};
 
 /// A scene family.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -407,7 +411,7 @@ pub fn report(outcomes: &[Outcome]) -> String {
 /// of the score that stood on a piece of its class (`true/n`), and the mean score against
 /// that share over all of them (a calibrated score has the two equal).
 fn reliability_lines(s: &mut String, rel: &[u32]) {
-    if rel.len() < score::RELIABILITY_LEN {
+    if rel.len() < RELIABILITY_LEN {
         return;
     }
     let _ = writeln!(
@@ -439,7 +443,7 @@ fn reliability_lines(s: &mut String, rel: &[u32]) {
 /// The Rust source of `models/src/calibration_counts.rs` from `eval-world --json` files: the
 /// sum of every family's detection reliability counts ([`Tally::reliability`]).
 pub fn calibration_counts(files: &[PathBuf], made_by: &str) -> Result<String, String> {
-    let mut sum = vec![0u32; score::RELIABILITY_LEN];
+    let mut sum = vec![0u32; RELIABILITY_LEN];
     let mut names = Vec::new();
     for f in files {
         let text = std::fs::read_to_string(f).map_err(|e| format!("{}: {e}", f.display()))?;
@@ -498,7 +502,7 @@ pub fn calibration_counts(files: &[PathBuf], made_by: &str) -> Result<String, St
         "/// The counts, laid out as `perception::calibration::COUNTS_LEN` says."
     );
     let _ = writeln!(s, "pub const COUNTS: [u32; {}] = [", sum.len());
-    for row in sum.chunks(score::SCORE_BINS * 2) {
+    for row in sum.chunks(SCORE_BINS * 2) {
         let cells: Vec<String> = row.iter().map(u32::to_string).collect();
         let _ = writeln!(s, "    {},", cells.join(", "));
     }

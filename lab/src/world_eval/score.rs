@@ -7,6 +7,10 @@ use perception::class::ObjectClass;
 use perception::geometry::{Point2, Pose2, wrap_angle};
 use serde_json::Value;
 
+pub use super::assignment::max_assignment;
+pub use super::places::{BESIDE_M, CLUTTER_M, DOORWAY_M, PHANTOM_PLACES, WALL_FACE_M};
+use super::places::{at_wall_face, phantom_place};
+use super::reliability;
 use crate::eval_a::class_index;
 use crate::run_truth::{Furniture, PERSON_VISIBLE_RETURNS, Person, RunTruth};
 
@@ -16,23 +20,6 @@ pub const MATCH_M: f32 = 0.3;
 pub const DOOR_MATCH_M: f32 = 0.5;
 /// A reported object is on a walking person when within this distance of the legs' midpoint.
 pub const PERSON_M: f32 = 0.4;
-/// A phantom lies at a wall face when within this distance of it.
-pub const WALL_FACE_M: f32 = 0.15;
-/// A phantom lies on a piece of clutter when within this distance of its centre.
-pub const CLUTTER_M: f32 = 0.5;
-/// A phantom lies beside a piece of furniture when within this distance of its footprint.
-pub const BESIDE_M: f32 = 0.8;
-/// A phantom lies at a doorway when within this distance of its centre.
-pub const DOORWAY_M: f32 = 1.0;
-/// Names of `Tally::phantoms_where`.
-pub const PHANTOM_PLACES: [&str; 5] = [
-    "clutter",
-    "beside furniture",
-    "doorway",
-    "wall face",
-    "open",
-];
-
 /// One reported object.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Reported {
@@ -209,29 +196,12 @@ pub struct Tally {
     /// How often a detection's score came true: for each source (A, B, AB), class (chair, box,
     /// desk, door frame) and tenth of the score, the detections and how many of them stood
     /// on a piece of their class (a door frame: on a door), `[n, true]` pairs in that order
-    /// ([`reliability_index`]); empty until a detection was scored.
+    /// ([`reliability::reliability_index`]); empty until a detection was scored.
     #[serde(default)]
     pub reliability: Vec<u32>,
     /// The reports on walking people, one line each (frame, id, class, source), for reading.
     #[serde(skip)]
     pub people_reports: Vec<String>,
-}
-
-/// Score bins of [`Tally::reliability`]: the calibration's tenths.
-pub const SCORE_BINS: usize = perception::calibration::SCORE_BINS;
-
-/// Length of [`Tally::reliability`]: 3 sources × 4 classes × [`SCORE_BINS`] × `[n, true]`,
-/// the layout `perception::calibration::Calibration::fit` reads.
-pub const RELIABILITY_LEN: usize = perception::calibration::COUNTS_LEN;
-
-/// Where a detection of `source` and `class` with `score` is counted in
-/// [`Tally::reliability`] (its `n`; `true` follows); None for a score that is not a number.
-pub fn reliability_index(source: usize, class: ObjectClass, score: f32) -> Option<usize> {
-    if !score.is_finite() {
-        return None;
-    }
-    let bin = ((score.clamp(0.0, 1.0) * SCORE_BINS as f32) as usize).min(SCORE_BINS - 1);
-    Some(((source.min(2) * 4 + class as usize) * SCORE_BINS + bin) * 2)
 }
 
 /// Class names of the tally's per-class arrays.
@@ -242,54 +212,6 @@ fn on_furniture<'a>(
     p: Point2,
 ) -> impl Iterator<Item = &'a &'a Furniture> + 'a {
     alive.iter().filter(move |f| f.distance(p) <= MATCH_M)
-}
-
-/// Whether `p` lies within `WALL_FACE_M` of a wall face.
-fn at_wall_face(truth: &RunTruth, p: Point2) -> bool {
-    truth
-        .walls
-        .iter()
-        .any(|(a, b)| p.distance_to_segment(*a, *b) <= WALL_FACE_M)
-}
-
-/// Where a phantom at `p` lies: an index into `PHANTOM_PLACES`.
-fn phantom_place(truth: &RunTruth, alive: &[&Furniture], p: Point2) -> usize {
-    if truth
-        .clutter
-        .iter()
-        .any(|(c, _)| c.distance(p) <= CLUTTER_M)
-    {
-        0
-    } else if alive.iter().any(|f| f.distance(p) <= BESIDE_M) {
-        1
-    } else if truth
-        .doors
-        .iter()
-        .any(|d| d.centre.distance(p) <= DOORWAY_M)
-    {
-        2
-    } else if at_wall_face(truth, p) {
-        3
-    } else {
-        4
-    }
-}
-
-/// Optimal one-to-one assignment maximising total weight (Hungarian, via `pathfinding`).
-pub fn max_assignment(w: &[Vec<i64>]) -> i64 {
-    let rows = w.len();
-    let cols = w.iter().map(Vec::len).max().unwrap_or(0);
-    let n = rows.max(cols);
-    if n == 0 {
-        return 0;
-    }
-    let mut m = pathfinding::matrix::Matrix::new(n, n, 0i64);
-    for (i, r) in w.iter().enumerate() {
-        for (j, &x) in r.iter().enumerate() {
-            m[(i, j)] = x;
-        }
-    }
-    pathfinding::kuhn_munkres::kuhn_munkres(&m).0
 }
 
 /// Scores one run's lines into `tally`.
@@ -330,13 +252,7 @@ pub fn score_run(truth: &RunTruth, lines: &[Line], tally: &mut Tally) {
                     } else {
                         on_furniture(&alive, o.at).any(|f| f.class == c)
                     };
-                    if let Some(k) = reliability_index(o.source, c, o.score) {
-                        if tally.reliability.len() < RELIABILITY_LEN {
-                            tally.reliability.resize(RELIABILITY_LEN, 0);
-                        }
-                        tally.reliability[k] += 1;
-                        tally.reliability[k + 1] += u32::from(right);
-                    }
+                    reliability::count(&mut tally.reliability, o.source, c, o.score, right);
                 }
                 match o.class {
                     Some(ObjectClass::DoorFrame) => {
@@ -852,6 +768,7 @@ mod test {
         };
         let mut s = Tally::default();
         score_run(&t, &[line], &mut s);
+        use reliability::{RELIABILITY_LEN, reliability_index};
         assert_eq!(s.reliability.len(), RELIABILITY_LEN);
         let at = |src, c, score| reliability_index(src, c, score).unwrap();
         let pair = |k: usize| [s.reliability[k], s.reliability[k + 1]];

@@ -30,9 +30,14 @@
 //!    it is deleted when existence falls below [`TrackConfig::delete_existence`], or when a
 //!    tentative track goes unseen for [`TrackConfig::tentative_frames`]. A track out of view
 //!    keeps its state: an object behind the robot is still in the room.
+//! 6. **Likelihood:** each observation's calibrated probability ([`TrackConfig::calibration`])
+//!    is summed; furniture whose mean is below [`TrackConfig::min_likelihood`] (desks:
+//!    [`TrackConfig::min_desk_likelihood`]) is not reported ([`Track::unlikely`],
+//!    `likelihood.rs`).
 //!
-//! This module is the core the frame loop's world model is built on; its wiring into the
-//! output line and its evaluation on unseen rooms are the next steps.
+//! Files: `merge.rs` (one object seen twice), `negative.rs` (what the rays say), `walkers.rs`
+//! (the leg detector's tracks), `door_marks.rs` (what the map's walls say of door frames),
+//! `likelihood.rs`.
 
 use heapless::Vec;
 
@@ -42,8 +47,9 @@ use crate::fusion::{Evidence, FrameObject};
 use crate::geometry::{Point2, Pose2};
 use crate::motion::{Motion, MotionConfig};
 use crate::sight::BINS;
-use crate::wall_map::WallMap;
 
+mod door_marks;
+mod likelihood;
 mod merge;
 mod negative;
 mod walkers;
@@ -230,36 +236,6 @@ impl Track {
         self.class() == ObjectClass::Box
             && self.box_wide_views == 0
             && self.narrow_views >= NARROW_VIEWS
-    }
-
-    /// The mean probability of its observations (0 before the first): how often the
-    /// methods' detections like these stood on a piece of their class.
-    pub fn likelihood(&self) -> f32 {
-        if self.hits == 0 {
-            0.0
-        } else {
-            self.p_sum / self.hits as f32
-        }
-    }
-
-    /// A piece of furniture whose observations were, on the whole, the kind that is wrong more
-    /// often than [`TrackConfig::min_likelihood`] allows (desks: or
-    /// [`TrackConfig::min_desk_likelihood`]): not reported while so. Door frames are judged by
-    /// the map's walls instead ([`Track::door_at_corner`]).
-    pub fn unlikely(&self, cfg: &TrackConfig) -> bool {
-        let least = match self.class() {
-            ObjectClass::DoorFrame => return false,
-            ObjectClass::Desk => cfg.min_likelihood.max(cfg.min_desk_likelihood),
-            _ => cfg.min_likelihood,
-        };
-        self.likelihood() < least
-    }
-
-    /// A door frame only Method B has seen, not in a doorway of the map's walls, at a corner
-    /// of them: the end of a wall seen end-on looks like a jamb to Method B (an L-shaped
-    /// room's inner corner). Not reported while so.
-    pub fn door_at_corner(&self) -> bool {
-        self.class() == ObjectClass::DoorFrame && self.at_corner && !self.seen_a && !self.anchored
     }
 
     /// Radius of the footprint negative evidence looks across, m (a desk's legs span ~1.8 m).
@@ -593,33 +569,6 @@ impl Tracks {
         }
     }
 
-    /// Door-frame tracks within their footprint of a doorway the map's walls showed this
-    /// revolution ([`crate::map_doors::observe`]) are openings in a wall from now on.
-    pub fn anchor_doors(&mut self, doorways: &[Point2]) {
-        for t in self.tracks.iter_mut() {
-            if t.class() == ObjectClass::DoorFrame
-                && doorways
-                    .iter()
-                    .any(|d| d.distance(t.centre) <= class_radius(ObjectClass::DoorFrame))
-            {
-                t.anchored = true;
-            }
-        }
-    }
-
-    /// Door-frame tracks within [`CORNER_DOOR_M`] of a corner of the map's walls: see
-    /// [`Track::door_at_corner`]; one reported is reported no more.
-    pub fn mark_corner_doors(&mut self, walls: &WallMap) {
-        for t in self.tracks.iter_mut() {
-            if t.class() == ObjectClass::DoorFrame {
-                t.at_corner = walls.corner_near(t.centre, CORNER_DOOR_M);
-                if t.door_at_corner() {
-                    t.confirmed = false;
-                }
-            }
-        }
-    }
-
     /// Makes room: the weakest tentative track goes, else the weakest of all.
     fn evict_weakest(&mut self) {
         let weakest = |only_tentative: bool| {
@@ -640,6 +589,7 @@ impl Tracks {
 #[cfg(test)]
 mod test {
     use super::*;
+    use crate::wall_map::WallMap;
 
     fn obs(class: ObjectClass, x: f32, y: f32, score: f32, evidence: Evidence) -> FrameObject {
         FrameObject {
