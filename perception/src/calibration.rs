@@ -17,6 +17,12 @@ pub const SCORE_BINS: usize = 10;
 /// reads (source A, B, AB; classes in [`ObjectClass::ALL`] order).
 pub const COUNTS_LEN: usize = 3 * 4 * SCORE_BINS * 2;
 
+/// Where the `n` of source `source` (0 = A, 1 = B, 2 = AB), class index `class` and score
+/// tenth `bin` lies in the counts [`Calibration::fit`] reads; its `true` count follows.
+pub const fn count_index(source: usize, class: usize, bin: usize) -> usize {
+    ((source * 4 + class) * SCORE_BINS + bin) * 2
+}
+
 /// Detections a (source, class) needs before its scores are recalibrated at all; with fewer
 /// its scores are taken as they are.
 pub const MIN_DETECTIONS: u32 = 20;
@@ -51,7 +57,7 @@ impl Calibration {
         }
         for (s, row) in c.p.iter_mut().enumerate() {
             for (k, slot) in row.iter_mut().enumerate() {
-                let at = |b: usize| ((s * 4 + k) * SCORE_BINS + b) * 2;
+                let at = |b: usize| count_index(s, k, b);
                 let total: u32 = (0..SCORE_BINS).map(|b| counts[at(b)]).sum();
                 if total < MIN_DETECTIONS {
                     continue;
@@ -160,7 +166,7 @@ mod test {
     fn counts(set: &[(usize, usize, usize, u32, u32)]) -> [u32; COUNTS_LEN] {
         let mut c = [0u32; COUNTS_LEN];
         for &(s, k, b, n, t) in set {
-            let at = ((s * 4 + k) * SCORE_BINS + b) * 2;
+            let at = count_index(s, k, b);
             c[at] = n;
             c[at + 1] = t;
         }

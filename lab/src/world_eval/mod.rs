@@ -420,7 +420,7 @@ fn reliability_lines(s: &mut String, rel: &[u32]) {
     );
     for (src, name) in ["A", "B", "AB"].iter().enumerate() {
         for (c, class) in ["chair", "box", "desk", "door frame"].iter().enumerate() {
-            let at = |bin: usize| ((src * 4 + c) * SCORE_BINS + bin) * 2;
+            let at = |bin: usize| perception::calibration::count_index(src, c, bin);
             let (n, ok): (u32, u32) =
                 (0..SCORE_BINS).fold((0, 0), |(n, ok), b| (n + rel[at(b)], ok + rel[at(b) + 1]));
             if n == 0 {

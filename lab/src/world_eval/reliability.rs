@@ -18,7 +18,11 @@ pub fn reliability_index(source: usize, class: ObjectClass, score: f32) -> Optio
         return None;
     }
     let bin = ((score.clamp(0.0, 1.0) * SCORE_BINS as f32) as usize).min(SCORE_BINS - 1);
-    Some(((source.min(2) * 4 + class as usize) * SCORE_BINS + bin) * 2)
+    Some(perception::calibration::count_index(
+        source.min(2),
+        class as usize,
+        bin,
+    ))
 }
 
 /// Counts a detection of `source`, `class` and `score` into `counts` (grown to

@@ -640,7 +640,7 @@ mod test {
         // and Method B's door frames at 0.5, 9 in 10.
         let mut counts = [0u32; crate::calibration::COUNTS_LEN];
         let mut set = |source: usize, class: ObjectClass, bin: usize, n: u32, t: u32| {
-            let at = ((source * 4 + class as usize) * crate::calibration::SCORE_BINS + bin) * 2;
+            let at = crate::calibration::count_index(source, class as usize, bin);
             counts[at] = n;
             counts[at + 1] = t;
         };
