@@ -49,6 +49,12 @@ pub const END_MARGIN_M: f32 = 0.05;
 pub const CORNER_JOIN_M: f32 = 0.4;
 /// Sine of the smallest angle between two lines that meet in a corner (45°).
 const CORNER_MIN_SIN: f32 = 0.707;
+/// A door frame whose centre is this close to a confirmed line (in front of its face or
+/// behind it, within a wall's thickness and a detection's scatter) stands in its line, m.
+pub const DOOR_LINE_M: f32 = 0.2;
+/// … and no farther beyond the line's end than half the widest doorway (0.7 m) and a jamb's
+/// allowance, m.
+pub const DOOR_REACH_M: f32 = 0.9;
 /// Weight at most of a line's past when a segment joins it (so a line can still settle).
 const MAX_WEIGHT: f32 = 20.0;
 /// Side votes are kept within ±this.
@@ -376,6 +382,22 @@ impl WallMap {
         })
     }
 
+    /// Whether `p` stands in the line of a confirmed wall: within [`DOOR_LINE_M`] of it, and
+    /// along it no farther than [`DOOR_REACH_M`] past one of its ends. A doorway is a gap in
+    /// a wall, so its middle is: a door frame in the open floor, or beside a wall's end but
+    /// off its line, is not.
+    pub fn in_wall_line(&self, p: Point2) -> bool {
+        if !(p.x.is_finite() && p.y.is_finite()) {
+            return false;
+        }
+        self.walls.iter().filter(|w| w.confirmed()).any(|w| {
+            let u = w.along(p);
+            libm::fabsf(w.in_front(p)) <= DOOR_LINE_M
+                && u >= w.lo - DOOR_REACH_M
+                && u <= w.hi + DOOR_REACH_M
+        })
+    }
+
     /// Whether `p` lies in a confirmed wall's band: less than [`IN_WALL_M`] in front of its
     /// face or up to [`BEHIND_M`] behind it, within its extent — unless `p` is well in front
     /// of another confirmed line facing the other way there (the far side of a thin wall
@@ -461,6 +483,29 @@ mod test {
         // The longer line spans both pieces.
         let long = map.walls().iter().map(MapWall::length).fold(0.0, f32::max);
         assert!((long - 3.0).abs() < 0.05, "{long}");
+    }
+
+    #[test]
+    fn a_doorway_stands_in_its_wall_line_open_floor_does_not() {
+        let mut map = WallMap::new();
+        // One jamb's wall, y = 2 for x ≤ 0; the other side of the doorway never seen.
+        let wall = [seg(-3.0, 2.0, 0.0, 2.0)];
+        seen(&mut map, &wall, 2);
+        assert!(
+            !map.in_wall_line(Point2::new(0.5, 2.05)),
+            "not yet confirmed"
+        );
+        seen(&mut map, &wall, 1);
+        // A doorway's middle past the line's end, on it or within a wall's thickness.
+        assert!(map.in_wall_line(Point2::new(0.5, 2.05)));
+        assert!(map.in_wall_line(Point2::new(0.8, 1.85)));
+        // In the wall's own extent too (a line the map joined across a doorway).
+        assert!(map.in_wall_line(Point2::new(-1.0, 2.1)));
+        // Off the line (the open floor in front of it), or farther past its end than half a
+        // doorway.
+        assert!(!map.in_wall_line(Point2::new(0.5, 1.6)));
+        assert!(!map.in_wall_line(Point2::new(1.2, 2.0)));
+        assert!(!map.in_wall_line(Point2::new(f32::NAN, 2.0)));
     }
 
     #[test]

@@ -16,9 +16,10 @@
 //!    existence falls by `free_loss`; in plain view and not observed, by `miss_loss` (only in
 //!    a frame in which a method that has seen it looked: [`Looked`], `negative.rs`). Rays
 //!    that end before it (something in front) say nothing. A door frame the map's walls showed
-//!    as a doorway ([`Tracks::anchor_doors`]) is an opening: rays through it are what it looks
-//!    like; it loses belief when its middle is seen closed, or when the rays pass its jambs'
-//!    places too (open floor). A door frame only Method B has seen, at a corner of the map's
+//!    as a doorway ([`Tracks::anchor_doors`]), or seen in [`TrackConfig::door_hold_hits`]
+//!    frames in a wall's line ([`Track::held_door`]), is an opening: rays through it are what
+//!    it looks like; it loses belief when its middle is seen closed, or when the rays pass its
+//!    jambs' places too (open floor). A door frame only Method B has seen, at a corner of the map's
 //!    walls and in no doorway of them, is not reported ([`Tracks::mark_corner_doors`]).
 //! 4. **New tracks** from unmatched observations (non-finite or absurd ones are refused and
 //!    counted); when the table is full the weakest tentative track, else the weakest track, is
@@ -119,6 +120,11 @@ pub struct TrackConfig {
     pub min_likelihood: f32,
     /// The same for desks alone (the larger of the two applies to them).
     pub min_desk_likelihood: f32,
+    /// A door frame with this many hits is a doorway of the map, as one the map's walls
+    /// showed is ([`Track::anchored`]): only what the rays show of it (shut, or no jambs
+    /// where they should be) speaks against it, not the methods' silence. A doorway does not
+    /// move away; 0: never.
+    pub door_hold_hits: u32,
 }
 
 impl Default for TrackConfig {
@@ -144,6 +150,7 @@ impl Default for TrackConfig {
             calibration: Calibration::IDENTITY,
             min_likelihood: 0.0,
             min_desk_likelihood: 0.0,
+            door_hold_hits: 0,
         }
     }
 }
@@ -192,6 +199,8 @@ pub struct Track {
     pub narrow_views: u16,
     /// A door frame at a corner of the map's walls ([`Tracks::mark_corner_doors`]).
     pub at_corner: bool,
+    /// A door frame in the line of one of the map's walls ([`Tracks::mark_corner_doors`]).
+    pub in_wall_line: bool,
     /// Sum of its observations' probabilities ([`TrackConfig::calibration`]); over its hits,
     /// how likely what the methods saw there was right ([`Track::likelihood`]).
     pub p_sum: f32,
@@ -496,6 +505,7 @@ impl Tracks {
                 box_wide_views: 0,
                 narrow_views: 0,
                 at_corner: false,
+                in_wall_line: false,
                 p_sum: 0.0,
             };
             Self::hit(&mut t, o, frame, stamp_s, cfg);
@@ -1140,6 +1150,64 @@ mod test {
             step(&mut t, f, &[], &Pose2::IDENTITY, &floor, &cfg);
         }
         assert_eq!(t.all().len(), 0, "not anchored, seen empty");
+    }
+
+    #[test]
+    fn a_door_seen_often_in_a_wall_line_is_held_through_the_methods_silence() {
+        use crate::walls::test_seg as seg;
+        let cfg = TrackConfig {
+            door_hold_hits: 20,
+            ..quick()
+        };
+        // The jambs' walls of a doorway 2 m ahead, x = 2, |y| ≥ 0.45: the map holds them.
+        let mut walls = WallMap::new();
+        for f in 0..3 {
+            walls.update(
+                f,
+                &[seg(2.0, -3.0, 2.0, -0.45), seg(2.0, 0.45, 2.0, 3.0)],
+                Point2::new(0.0, 0.0),
+            );
+        }
+        let mut open = ranges(4.0);
+        for d in [12, 13, 14, 15, 345, 346, 347, 348] {
+            open[d] = 2.05;
+        }
+        let door = obs(ObjectClass::DoorFrame, 2.0, 0.0, 0.9, Evidence::B);
+        // Seen in `hits` frames, then not detected for 4 s, in plain view and open.
+        let run = |hits: u64, cfg: &TrackConfig, walls: &WallMap| {
+            let mut t = Tracks::new();
+            for f in 0..hits {
+                step(&mut t, f, &[door], &Pose2::IDENTITY, &open, cfg);
+                t.mark_corner_doors(walls);
+            }
+            assert_eq!(t.confirmed().count(), 1);
+            for f in hits..hits + 20 {
+                step(&mut t, f, &[], &Pose2::IDENTITY, &open, cfg);
+                t.mark_corner_doors(walls);
+            }
+            t.confirmed().count()
+        };
+        assert_eq!(run(25, &cfg, &walls), 1, "held");
+        // Seen too few times, or the hold off, or not in a line of the map's walls: the
+        // methods' silence in plain view takes it off the map as before.
+        assert_eq!(run(12, &cfg, &walls), 0, "too few sightings");
+        let off = TrackConfig {
+            door_hold_hits: 0,
+            ..cfg
+        };
+        assert_eq!(run(25, &off, &walls), 0, "hold off");
+        assert_eq!(run(25, &cfg, &WallMap::new()), 0, "in no wall's line");
+        // Held, it still leaves when the doorway is seen shut.
+        let mut t = Tracks::new();
+        for f in 0..25 {
+            step(&mut t, f, &[door], &Pose2::IDENTITY, &open, &cfg);
+            t.mark_corner_doors(&walls);
+        }
+        for f in 25..45 {
+            step(&mut t, f, &[], &Pose2::IDENTITY, &ranges(2.0), &cfg);
+            t.mark_corner_doors(&walls);
+        }
+        assert_eq!(t.all().len(), 0, "a shut door leaves the map");
     }
 
     #[test]

@@ -52,7 +52,7 @@ pub(super) fn unobserved(
     cfg: &TrackConfig,
 ) {
     let looked_for = looked.for_track(t);
-    let (loss, in_view) = if t.class() == ObjectClass::DoorFrame && t.anchored {
+    let (loss, in_view) = if t.held_door(cfg) {
         // An opening in a wall: seen through is what it looks like.
         let jambs = if t.width_m > 0.0 {
             0.5 * t.width_m
