@@ -17,7 +17,7 @@ impl Track {
         self.class() == ObjectClass::DoorFrame && self.at_corner && !self.seen_a && !self.anchored
     }
 
-    /// A door frame judged as a doorway ([`super::negative`]): the map's walls showed it
+    /// A door frame judged as a doorway by what the rays show of it: the map's walls showed it
     /// ([`Track::anchored`]), or the methods saw it in [`TrackConfig::door_hold_hits`]
     /// frames.
     pub fn held_door(&self, cfg: &TrackConfig) -> bool {
