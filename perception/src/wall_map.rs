@@ -114,6 +114,12 @@ impl MapWall {
         (p - self.origin).dot(self.dir)
     }
 
+    /// Whether `p` lies along the line within its extent widened by `margin` m at each end.
+    fn spans(&self, p: Point2, margin: f32) -> bool {
+        let u = self.along(p);
+        u >= self.lo - margin && u <= self.hi + margin
+    }
+
     /// Signed distance from the face, positive on the room's side.
     pub(crate) fn in_front(&self, p: Point2) -> f32 {
         (p - self.origin).dot(self.room_normal())
@@ -390,11 +396,8 @@ impl WallMap {
         if !(p.x.is_finite() && p.y.is_finite()) {
             return false;
         }
-        self.walls.iter().filter(|w| w.confirmed()).any(|w| {
-            let u = w.along(p);
-            libm::fabsf(w.in_front(p)) <= DOOR_LINE_M
-                && u >= w.lo - DOOR_REACH_M
-                && u <= w.hi + DOOR_REACH_M
+        self.walls.iter().any(|w| {
+            w.confirmed() && libm::fabsf(w.in_front(p)) <= DOOR_LINE_M && w.spans(p, DOOR_REACH_M)
         })
     }
 
@@ -406,10 +409,7 @@ impl WallMap {
         if !(p.x.is_finite() && p.y.is_finite()) {
             return false;
         }
-        let within = |w: &MapWall| {
-            let u = w.along(p);
-            u >= w.lo - END_MARGIN_M && u <= w.hi + END_MARGIN_M
-        };
+        let within = |w: &MapWall| w.spans(p, END_MARGIN_M);
         self.walls
             .iter()
             .filter(|w| w.confirmed() && within(w))

@@ -644,6 +644,16 @@ mod test {
 
     const CHAIR: ObjectClass = ObjectClass::Chair;
 
+    /// A map whose walls are `segs`, seen from the origin in enough revolutions to confirm
+    /// them.
+    fn walls_seen(segs: &[crate::walls::Segment]) -> WallMap {
+        let mut walls = WallMap::new();
+        for f in 0..3 {
+            walls.update(f, segs, Point2::new(0.0, 0.0));
+        }
+        walls
+    }
+
     #[test]
     fn furniture_seen_only_in_ways_that_are_mostly_wrong_is_unlikely() {
         // Method B's boxes at 0.5 stood on a box 2 times in 10; what both methods agreed on,
@@ -1050,14 +1060,7 @@ mod test {
             ..quick()
         };
         // An L's inner corner at (1, 2), the map's walls seen from the origin.
-        let mut walls = WallMap::new();
-        for f in 0..3 {
-            walls.update(
-                f,
-                &[seg(-3.0, 2.0, 1.0, 2.0), seg(1.0, 2.0, 1.0, 4.0)],
-                Point2::new(0.0, 0.0),
-            );
-        }
+        let walls = walls_seen(&[seg(-3.0, 2.0, 1.0, 2.0), seg(1.0, 2.0, 1.0, 4.0)]);
         let scan = ranges(0.0);
         // A door frame at (x, y) seen in six frames; the corners marked after each, or not.
         let seen = |x: f32, y: f32, evidence: Evidence, mark: bool| {
@@ -1160,14 +1163,7 @@ mod test {
             ..quick()
         };
         // The jambs' walls of a doorway 2 m ahead, x = 2, |y| ≥ 0.45: the map holds them.
-        let mut walls = WallMap::new();
-        for f in 0..3 {
-            walls.update(
-                f,
-                &[seg(2.0, -3.0, 2.0, -0.45), seg(2.0, 0.45, 2.0, 3.0)],
-                Point2::new(0.0, 0.0),
-            );
-        }
+        let walls = walls_seen(&[seg(2.0, -3.0, 2.0, -0.45), seg(2.0, 0.45, 2.0, 3.0)]);
         let mut open = ranges(4.0);
         for d in [12, 13, 14, 15, 345, 346, 347, 348] {
             open[d] = 2.05;
