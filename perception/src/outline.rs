@@ -1,13 +1,13 @@
 //! What a detection's own returns say against its class: a box has flat faces, so a box whose
 //! returns lie on an arc — a bin, a round pillar, a person's leg — is not a box. The longest
-//! unbroken run of the revolution's returns near the centre is fitted three ways: a line, two
-//! lines meeting at the point farthest from its chord (a box seen across a corner), and a
-//! circle (Kåsa's algebraic fit). It is round when the circle fits markedly better than one
-//! line and better than two,
-//! with a radius of a bin or a pillar, bulging towards the LiDAR (where the range noise swamps
-//! the curve, the three fits read alike and the returns say nothing). `no_std`,
-//! allocation-free.
-
+//! unbroken run of the revolution's returns near the centre is fitted four ways ([`fits`]): a
+//! line, two lines meeting at the point farthest from its chord (a box seen across a corner),
+//! the same two at a right angle, and a circle (Kåsa's algebraic fit). One revolution is round
+//! ([`is_round`]) when the circle fits markedly better than one line and better than two, with
+//! a radius of a bin or a pillar, bulging towards the LiDAR (where the range noise swamps the
+//! curve, the fits read alike and the returns say nothing). A track sums the fits over its
+//! revolutions, where the noise averages out ([`crate::tracks::Track::looks_round`]).
+//! `no_std`, allocation-free.
 use heapless::Vec;
 
 use crate::class::ObjectClass;
@@ -153,20 +153,52 @@ pub fn box_wide(centre: Point2, lidar: &Pose2, pts: &[Option<Point2>; BINS]) -> 
 
 /// [`is_round`] on the revolution's returns already converted ([`returns`]).
 fn is_round_in(centre: Point2, lidar: &Pose2, pts: &[Option<Point2>; BINS]) -> bool {
-    let Some((c, _, spacing)) = seen_from(centre, lidar) else {
-        return false;
-    };
+    fits(centre, lidar, pts).is_some_and(|f| f.round())
+}
+
+/// One revolution's three fits of the returns near a detection ([`fits`]), each as its sum of
+/// squared distances (m²). Per degree of freedom (points less parameters) each reads the range
+/// noise's variance where its model is right: summed over revolutions the noise averages out,
+/// and what is left says which shape the returns have ([`crate::tracks::Track::looks_round`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Fits {
+    /// Returns in the run.
+    pub n: usize,
+    /// The circle has the radius of a bin or a pillar, bulges towards the LiDAR, and the run
+    /// leaves a straight line by [`MIN_CURVE_M`]: an arc could be what was seen.
+    pub arc: bool,
+    /// Circle (3 parameters).
+    pub circle: f32,
+    /// Two lines meeting at the point farthest from the chord (4 parameters).
+    pub two: f32,
+    /// Two lines at a right angle split at that point, as a box's corner is (3 parameters).
+    pub corner: f32,
+    /// One line (2 parameters).
+    pub line: f32,
+}
+
+impl Fits {
+    /// One revolution's verdict ([`is_round`]): an arc whose circle fits markedly better than
+    /// one line and no worse than two.
+    pub fn round(&self) -> bool {
+        self.arc
+            && self.circle <= ROUND_RATIO * ROUND_RATIO * self.line
+            && self.circle <= CORNER_RATIO * CORNER_RATIO * self.two
+    }
+}
+
+/// The fits of the longest unbroken run of one revolution's returns near `centre` (map frame;
+/// `pts` from [`returns`], seen from `lidar`); `None` with fewer than [`MIN_POINTS`] returns
+/// there, or no circle through them.
+pub fn fits(centre: Point2, lidar: &Pose2, pts: &[Option<Point2>; BINS]) -> Option<Fits> {
+    let (c, _, spacing) = seen_from(centre, lidar)?;
     let (best, _, _) = near_run(c, pts, NEAR_M, (3.0 * spacing).max(0.06), false);
     if best.len() < MIN_POINTS {
-        return false;
+        return None;
     }
     let pts = &best[..];
     let line = line_sse(pts);
     let n = pts.len() as f32;
-    let rms_line = libm::sqrtf(line / n);
-    if rms_line < MIN_CURVE_M {
-        return false; // straight: nothing to say
-    }
     // Two lines split at the point farthest from the chord.
     let (a, b) = (pts[0], pts[pts.len() - 1]);
     let e = b - a;
@@ -177,33 +209,35 @@ fn is_round_in(centre: Point2, lidar: &Pose2, pts: &[Option<Point2>; BINS]) -> b
             di.total_cmp(&dj)
         })
         .unwrap_or(0);
-    let two = if far >= 1 && far + 2 <= pts.len() {
-        line_sse(&pts[..=far]) + line_sse(&pts[far..])
+    let (two, corner) = if far >= 1 && far + 2 <= pts.len() {
+        let (first, second) = (&pts[..=far], &pts[far..]);
+        (
+            line_sse(first) + line_sse(second),
+            right_angle_sse(first, second),
+        )
     } else {
-        line
+        (line, line)
     };
-    let rms_two = libm::sqrtf(two / n);
-    let Some((cc, r, sse)) = circle(pts) else {
-        return false;
-    };
-    let rms_circle = libm::sqrtf(sse / n);
+    let (cc, r, circle) = circle(pts)?;
     let mean = pts.iter().fold(Point2::new(0.0, 0.0), |s, p| s + *p);
     let mean = Point2::new(mean.x / n, mean.y / n);
-    #[cfg(test)]
-    std::eprintln!(
-        "n {n} line {rms_line} two {rms_two} circle {rms_circle} r {r} cc {cc:?} mean {mean:?}"
-    );
-    (MIN_RADIUS_M..=MAX_RADIUS_M).contains(&r)
-        && cc.norm() > mean.norm()
-        && rms_circle <= ROUND_RATIO * rms_line
-        && rms_circle <= CORNER_RATIO * rms_two
+    Some(Fits {
+        n: pts.len(),
+        arc: (MIN_RADIUS_M..=MAX_RADIUS_M).contains(&r)
+            && cc.norm() > mean.norm()
+            && libm::sqrtf(line / n) >= MIN_CURVE_M,
+        circle,
+        two,
+        corner,
+        line,
+    })
 }
 
-/// Sum of squared distances of `pts` from their principal axis.
-fn line_sse(pts: &[Point2]) -> f32 {
+/// The scatter matrix of `pts` about their mean: (Σdx², Σdx·dy, Σdy²).
+fn scatter(pts: &[Point2]) -> (f32, f32, f32) {
     let n = pts.len() as f32;
-    if n < 2.0 {
-        return 0.0;
+    if n < 1.0 {
+        return (0.0, 0.0, 0.0);
     }
     let m = pts.iter().fold(Point2::new(0.0, 0.0), |s, p| s + *p);
     let m = Point2::new(m.x / n, m.y / n);
@@ -214,9 +248,34 @@ fn line_sse(pts: &[Point2]) -> f32 {
         cxy += d.x * d.y;
         cyy += d.y * d.y;
     }
-    let half_tr = 0.5 * (cxx + cyy);
-    let det = cxx * cyy - cxy * cxy;
-    (half_tr - libm::sqrtf((half_tr * half_tr - det).max(0.0))).max(0.0)
+    (cxx, cxy, cyy)
+}
+
+/// The smaller eigenvalue of the symmetric matrix [[a, b], [b, c]].
+fn min_eigen(a: f32, b: f32, c: f32) -> f32 {
+    let half_tr = 0.5 * (a + c);
+    let det = a * c - b * b;
+    half_tr - libm::sqrtf((half_tr * half_tr - det).max(0.0))
+}
+
+/// Sum of squared distances of `pts` from their principal axis.
+fn line_sse(pts: &[Point2]) -> f32 {
+    if pts.len() < 2 {
+        return 0.0;
+    }
+    let (cxx, cxy, cyy) = scatter(pts);
+    min_eigen(cxx, cxy, cyy).max(0.0)
+}
+
+/// Sum of squared distances of `first` from one line and of `second` from a line at a right
+/// angle to it (a box seen across a corner: 3 parameters, the circle's count). With unit
+/// normal `n` of the first line the sum is `nᵀ S₁ n + tᵀ S₂ t`, `t ⊥ n`, which is
+/// `nᵀ (S₁ − S₂) n + trace S₂`: its least is the smaller eigenvalue of `S₁ − S₂` plus
+/// `trace S₂`.
+fn right_angle_sse(first: &[Point2], second: &[Point2]) -> f32 {
+    let (a1, b1, c1) = scatter(first);
+    let (a2, b2, c2) = scatter(second);
+    (min_eigen(a1 - a2, b1 - b2, c1 - c2) + a2 + c2).max(0.0)
 }
 
 /// Kåsa's circle through `pts`: centre, radius and the sum of squared radial residuals.
@@ -273,11 +332,14 @@ pub fn drop_round_boxes(
 }
 
 #[cfg(test)]
-mod test {
+pub(crate) mod test {
     use super::*;
 
     /// A revolution from the origin with a wall along x = 4 and a circle or a box in front.
-    fn scan(round: Option<(Point2, f32)>, square: Option<(Point2, f32, f32, f32)>) -> [f32; BINS] {
+    pub(crate) fn scan(
+        round: Option<(Point2, f32)>,
+        square: Option<(Point2, f32, f32, f32)>,
+    ) -> [f32; BINS] {
         let mut r = [0.0f32; BINS];
         for (d, slot) in r.iter_mut().enumerate() {
             let a = (d as f32).to_radians();
@@ -326,7 +388,8 @@ mod test {
         r
     }
 
-    fn noisy(mut r: [f32; BINS], frac: f32, seed: u32) -> [f32; BINS] {
+    /// `r` with range noise σ = 5 mm + `frac` of the range (the annex's model at 0.006).
+    pub(crate) fn noisy(mut r: [f32; BINS], frac: f32, seed: u32) -> [f32; BINS] {
         let mut x = seed;
         let mut uniform = || {
             x = x.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);

@@ -414,8 +414,9 @@ impl<S: RevolutionStream> FrameLoop<'_, S> {
             st.tracks.anchor_doors(&doorways);
             // Nor is Method B's door frame at a corner of them.
             st.tracks.mark_corner_doors(&st.wall_map);
-            // How wide the boxes look: a bin or a post is narrower than any box.
-            st.tracks.measure_widths(&lidar, &returns);
+            // How wide the boxes look and whether they are round: a bin or a post is narrower
+            // than any box, and a pillar's returns lie on an arc.
+            st.tracks.measure_outlines(&lidar, &returns);
             // People: leg-sized blobs of this revolution off the map's walls, tracked; the
             // ones that walk.
             if cfg.walkers {
@@ -440,8 +441,9 @@ impl<S: RevolutionStream> FrameLoop<'_, S> {
                 if t.class() != ObjectClass::DoorFrame && st.wall_map.holds(t.centre) {
                     continue;
                 }
-                // A "box" never seen as wide as a box is a bin or a pillar.
-                if t.too_narrow() {
+                // A "box" never seen as wide as a box, or whose returns lie on an arc in most
+                // revolutions, is a bin or a pillar.
+                if t.too_narrow() || t.looks_round() {
                     continue;
                 }
                 // Furniture seen only in the ways the methods are mostly wrong.
