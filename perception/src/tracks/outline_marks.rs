@@ -1,0 +1,89 @@
+//! What a box track's own returns say of its shape, revolution after revolution: a "box" never
+//! seen as wide as any box is a post or a bin ([`Track::too_narrow`]); one whose returns lie
+//! on an arc is a bin or a round pillar ([`Track::looks_round`]). Neither is reported while so.
+//! The views are counted by [`Tracks::measure_outlines`] (`crate::outline` measures one
+//! revolution).
+
+use crate::class::ObjectClass;
+use crate::geometry::{Point2, Pose2};
+use crate::sight::BINS;
+
+use super::{Track, Tracks};
+
+/// Narrow views before a "box" never seen box-wide is not reported ([`Track::too_narrow`]).
+pub const NARROW_VIEWS: u16 = 3;
+
+/// Revolutions whose returns could lie on an arc ([`crate::outline::Fits::arc`]) at least
+/// before a "box" may be found round ([`Track::looks_round`]).
+pub const ROUND_VIEWS: u16 = 3;
+/// A round "box": over its arc-shaped revolutions, the circle's variance per degree of freedom
+/// at most this share of a right-angled corner's (a box seen across a corner: the corner fits
+/// to the noise, a circle worse; a pillar: the reverse). Both have 3 parameters; two free
+/// lines (4, and the split) fit a short noisy arc as well as a circle does ...
+pub const ROUND_CORNER_RATIO: f32 = 0.65;
+/// ... and of one line's.
+pub const ROUND_LINE_RATIO: f32 = 0.6;
+
+impl Track {
+    /// A "box" whose returns looked narrower than any box in [`NARROW_VIEWS`] revolutions and
+    /// never as wide as one: a bin, a round pillar, a post ([`crate::outline::box_wide`]).
+    /// Not reported while so. Something in front narrows a box, nothing widens a post: one
+    /// box-wide view outweighs any number of narrow ones.
+    pub fn too_narrow(&self) -> bool {
+        self.class() == ObjectClass::Box
+            && self.box_wide_views == 0
+            && self.narrow_views >= NARROW_VIEWS
+    }
+
+    /// A "box" whose returns lie on an arc: in [`ROUND_VIEWS`] revolutions and more than not
+    /// they could, and over those revolutions together a circle fits them better than a
+    /// right-angled corner ([`ROUND_CORNER_RATIO`]) and than one line ([`ROUND_LINE_RATIO`]). A bin or a round
+    /// pillar; not reported while so. One revolution's few returns cannot tell a pillar's arc
+    /// from a box's corner under the range noise; summed over revolutions the noise averages
+    /// out, and where it swamps the curve the sums read alike and the rule does not fire.
+    pub fn looks_round(&self) -> bool {
+        let [circle, corner, line] = self.arc_fits;
+        self.class() == ObjectClass::Box
+            && self.arc_views >= ROUND_VIEWS
+            && self.arc_views > self.flat_views
+            && circle <= ROUND_CORNER_RATIO * corner
+            && circle <= ROUND_LINE_RATIO * line
+    }
+}
+
+impl Tracks {
+    /// Box tracks that stand still: whether their returns in this revolution look as wide as
+    /// a box ([`crate::outline::box_wide`]) and how they fit an arc
+    /// ([`crate::outline::fits`]); `pts` from [`crate::sight::returns`], `lidar` the
+    /// LiDAR's pose in the map. Counted into [`Track::too_narrow`]'s and
+    /// [`Track::looks_round`]'s views.
+    pub fn measure_outlines(&mut self, lidar: &Pose2, pts: &[Option<Point2>; BINS]) {
+        for t in self.tracks.iter_mut() {
+            if t.class() == ObjectClass::Box && !t.motion.moving {
+                match crate::outline::box_wide(t.centre, lidar, pts) {
+                    Some(true) => t.box_wide_views = t.box_wide_views.saturating_add(1),
+                    Some(false) => t.narrow_views = t.narrow_views.saturating_add(1),
+                    None => {}
+                }
+                match crate::outline::fits(t.centre, lidar, pts) {
+                    Some(f) if f.arc => {
+                        t.arc_views = t.arc_views.saturating_add(1);
+                        let n = f.n as f32;
+                        let per_dof = [
+                            f.circle / (n - 3.0),
+                            f.corner / (n - 3.0),
+                            f.line / (n - 2.0),
+                        ];
+                        for (sum, v) in t.arc_fits.iter_mut().zip(per_dof) {
+                            if v.is_finite() {
+                                *sum += v;
+                            }
+                        }
+                    }
+                    Some(_) => t.flat_views = t.flat_views.saturating_add(1),
+                    None => {}
+                }
+            }
+        }
+    }
+}
