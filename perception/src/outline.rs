@@ -8,6 +8,7 @@
 //! curve, the fits read alike and the returns say nothing). A track sums the fits over its
 //! revolutions, where the noise averages out ([`crate::tracks::Track::looks_round`]).
 //! `no_std`, allocation-free.
+
 use heapless::Vec;
 
 use crate::class::ObjectClass;
@@ -156,7 +157,7 @@ fn is_round_in(centre: Point2, lidar: &Pose2, pts: &[Option<Point2>; BINS]) -> b
     fits(centre, lidar, pts).is_some_and(|f| f.round())
 }
 
-/// One revolution's three fits of the returns near a detection ([`fits`]), each as its sum of
+/// One revolution's four fits of the returns near a detection ([`fits`]), each as its sum of
 /// squared distances (m²). Per degree of freedom (points less parameters) each reads the range
 /// noise's variance where its model is right: summed over revolutions the noise averages out,
 /// and what is left says which shape the returns have ([`crate::tracks::Track::looks_round`]).
@@ -178,6 +179,18 @@ pub struct Fits {
 }
 
 impl Fits {
+    /// The circle's, the right-angled corner's and one line's sums per degree of freedom
+    /// (returns less the model's parameters: 3, 3 and 2), m²: what a track sums over its
+    /// revolutions.
+    pub fn variances(&self) -> [f32; 3] {
+        let n = self.n as f32;
+        [
+            self.circle / (n - 3.0),
+            self.corner / (n - 3.0),
+            self.line / (n - 2.0),
+        ]
+    }
+
     /// One revolution's verdict ([`is_round`]): an arc whose circle fits markedly better than
     /// one line and no worse than two.
     pub fn round(&self) -> bool {

@@ -781,7 +781,7 @@ mod test {
 
     #[test]
     fn a_pillar_looks_round_over_revolutions_a_box_never_does() {
-        use crate::outline::test::scan;
+        use crate::outline::test::{noisy, scan};
         let mut missed = 0;
         for range in [1.0f32, 2.0, 3.0] {
             for rad in [0.15f32, 0.2, 0.25, 0.3] {
@@ -822,11 +822,7 @@ mod test {
             &quick(),
         );
         for seed in 0..20 {
-            let r = crate::outline::test::noisy(
-                crate::outline::test::scan(Some((c, 0.2)), None),
-                0.006,
-                seed,
-            );
+            let r = noisy(scan(Some((c, 0.2)), None), 0.006, seed);
             t.measure_outlines(&Pose2::IDENTITY, &crate::sight::returns(&r));
         }
         assert!(!t.all()[0].looks_round() && t.all()[0].arc_views == 0);

@@ -37,8 +37,8 @@ impl Track {
 
     /// A "box" whose returns lie on an arc: in [`ROUND_VIEWS`] revolutions and more than not
     /// they could, and over those revolutions together a circle fits them better than a
-    /// right-angled corner ([`ROUND_CORNER_RATIO`]) and than one line ([`ROUND_LINE_RATIO`]). A bin or a round
-    /// pillar; not reported while so. One revolution's few returns cannot tell a pillar's arc
+    /// right-angled corner ([`ROUND_CORNER_RATIO`]) and than one line
+    /// ([`ROUND_LINE_RATIO`]). A bin or a round pillar; not reported while so. One revolution's few returns cannot tell a pillar's arc
     /// from a box's corner under the range noise; summed over revolutions the noise averages
     /// out, and where it swamps the curve the sums read alike and the rule does not fire.
     pub fn looks_round(&self) -> bool {
@@ -68,13 +68,7 @@ impl Tracks {
                 match crate::outline::fits(t.centre, lidar, pts) {
                     Some(f) if f.arc => {
                         t.arc_views = t.arc_views.saturating_add(1);
-                        let n = f.n as f32;
-                        let per_dof = [
-                            f.circle / (n - 3.0),
-                            f.corner / (n - 3.0),
-                            f.line / (n - 2.0),
-                        ];
-                        for (sum, v) in t.arc_fits.iter_mut().zip(per_dof) {
+                        for (sum, v) in t.arc_fits.iter_mut().zip(f.variances()) {
                             if v.is_finite() {
                                 *sum += v;
                             }
