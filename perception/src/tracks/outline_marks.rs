@@ -38,9 +38,10 @@ impl Track {
     /// A "box" whose returns lie on an arc: in [`ROUND_VIEWS`] revolutions and more than not
     /// they could, and over those revolutions together a circle fits them better than a
     /// right-angled corner ([`ROUND_CORNER_RATIO`]) and than one line
-    /// ([`ROUND_LINE_RATIO`]). A bin or a round pillar; not reported while so. One revolution's few returns cannot tell a pillar's arc
-    /// from a box's corner under the range noise; summed over revolutions the noise averages
-    /// out, and where it swamps the curve the sums read alike and the rule does not fire.
+    /// ([`ROUND_LINE_RATIO`]). A bin or a round pillar; not reported while so. One
+    /// revolution's few returns cannot tell a pillar's arc from a box's corner under the range
+    /// noise; summed over revolutions the noise averages out, and where it swamps the curve
+    /// the sums read alike and the rule does not fire.
     pub fn looks_round(&self) -> bool {
         let [circle, corner, line] = self.arc_fits;
         self.class() == ObjectClass::Box
