@@ -188,10 +188,25 @@ pub fn legs(ranges: &[f32; BINS], cfg: &LegConfig) -> Vec<Point2, MAX_LEGS> {
     out
 }
 
+/// The leg candidates of a revolution ([`legs`]) placed in the map frame by `lidar`.
+pub fn legs_in_map(ranges: &[f32; BINS], lidar: &Pose2, cfg: &LegConfig) -> Vec<Point2, MAX_LEGS> {
+    let mut out = legs(ranges, cfg);
+    for p in out.iter_mut() {
+        *p = lidar.transform(*p);
+    }
+    out
+}
+
 /// The person candidates of a revolution seen from `lidar` (map frame): legs paired nearest
 /// first within [`LegConfig::max_pair_m`], a leg left over is a person alone.
 pub fn persons(ranges: &[f32; BINS], lidar: &Pose2, cfg: &LegConfig) -> Persons {
-    let legs = legs(ranges, cfg);
+    pair(&legs_in_map(ranges, lidar, cfg), cfg)
+}
+
+/// Person candidates from leg candidates (any one frame): legs paired nearest first within
+/// [`LegConfig::max_pair_m`] (their midpoint), a leg left over is a person alone.
+pub fn pair(legs: &[Point2], cfg: &LegConfig) -> Persons {
+    let legs = &legs[..legs.len().min(MAX_LEGS)];
     let mut paired = [false; MAX_LEGS];
     let mut out = Persons::new();
     loop {
@@ -213,7 +228,7 @@ pub fn persons(ranges: &[f32; BINS], lidar: &Pose2, cfg: &LegConfig) -> Persons 
         let mid = Point2::new((legs[i].x + legs[j].x) / 2.0, (legs[i].y + legs[j].y) / 2.0);
         if out
             .push(Person {
-                centre: lidar.transform(mid),
+                centre: mid,
                 legs: 2,
             })
             .is_err()
@@ -224,7 +239,7 @@ pub fn persons(ranges: &[f32; BINS], lidar: &Pose2, cfg: &LegConfig) -> Persons 
     for (leg, _) in legs.iter().zip(paired).filter(|(_, p)| !p) {
         if out
             .push(Person {
-                centre: lidar.transform(*leg),
+                centre: *leg,
                 legs: 1,
             })
             .is_err()

@@ -28,6 +28,7 @@
 //! | [`fusion`]     | one frame's objects from both methods: A's, and B's joined or added |
 //! | [`calibration`] | what a detection's score means: a measured probability per source and class |
 //! | [`sight`]      | what a revolution showed of a footprint (hidden, in view, seen empty) or a doorway |
+//! | [`still_legs`] | where leg-sized things stand still: a background for the leg detector |
 //! | [`motion`]     | a track's alpha–beta motion filter; walking legs told from furniture |
 //! | [`legs`]       | people's legs in a revolution: leg-sized free-standing blobs, paired |
 //! | [`tracks`]     | the world model's tracks: stable ids, association, evidence, negative evidence |
@@ -57,6 +58,7 @@ pub mod raster;
 pub mod scan_match;
 pub mod shape;
 pub mod sight;
+pub mod still_legs;
 pub mod tracks;
 pub mod wall_map;
 pub mod wall_piece;

@@ -149,6 +149,11 @@ fn buffers_in_code() -> Vec<(&'static str, usize, usize)> {
             size_of::<perception::tracks::Walker>(),
         ),
         (
+            "perception::still_legs::MAX_SPOTS",
+            perception::still_legs::MAX_SPOTS,
+            size_of::<perception::still_legs::Spot>(),
+        ),
+        (
             "perception::legs::MAX_LEGS",
             perception::legs::MAX_LEGS,
             size_of::<Point2>(),

@@ -10,7 +10,7 @@ use perception::class::ObjectClass;
 use perception::cloud::Scan;
 use perception::fusion::{Evidence, FrameObjects, merge_b, push_a};
 use perception::geometry::{Point2, Pose2};
-use perception::legs::LegConfig;
+use perception::legs::{LegConfig, legs_in_map};
 use perception::map_doors::{Doorways, MapDoorConfig};
 use perception::method_a::{MethodA, MethodAConfig};
 use perception::outline::drop_round_boxes;
@@ -417,13 +417,13 @@ impl<S: RevolutionStream> FrameLoop<'_, S> {
             // How wide the boxes look and whether they are round: a bin or a post is narrower
             // than any box, and a pillar's returns lie on an arc.
             st.tracks.measure_outlines(&lidar, &returns);
-            // People: leg-sized blobs of this revolution off the map's walls, tracked; the
-            // ones that walk.
+            // People: leg-sized blobs off the walls and not standing still; those that walk.
             if cfg.walkers {
-                let mut persons =
-                    perception::legs::persons(st.history.newest(), &lidar, &LegConfig::default());
-                persons.retain(|p| !st.wall_map.holds(p.centre));
-                st.tracks.update_walkers(frame, mid_s, &persons, cfg);
+                let leg_cfg = LegConfig::default();
+                let mut legs = legs_in_map(st.history.newest(), &lidar, &leg_cfg);
+                legs.retain(|p| !st.wall_map.holds(*p));
+                st.tracks
+                    .update_legs(frame, mid_s, &mut legs, &leg_cfg, cfg);
             }
             st.people.clear();
             for (id, w) in st.tracks.walkers().people(frame, PEOPLE_FRAMES) {

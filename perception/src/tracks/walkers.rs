@@ -12,8 +12,9 @@ use heapless::Vec;
 
 use super::{PEOPLE_FRAMES, TrackConfig, Tracks};
 use crate::geometry::Point2;
-use crate::legs::Person;
+use crate::legs::{LegConfig, MAX_LEGS, Person};
 use crate::motion::{Motion, MotionConfig};
+use crate::still_legs::StillLegs;
 
 /// Walkers held at most (people and the leg-sized things that stand still).
 pub const MAX_WALKERS: usize = 24;
@@ -53,12 +54,17 @@ impl Walker {
 #[derive(Debug, Clone, Default)]
 pub struct Walkers {
     list: Vec<Walker, MAX_WALKERS>,
+    /// Where leg-sized things stand still ([`Tracks::update_legs`] leaves them out).
+    still: StillLegs,
 }
 
 impl Walkers {
     /// An empty table.
     pub const fn new() -> Self {
-        Walkers { list: Vec::new() }
+        Walkers {
+            list: Vec::new(),
+            still: StillLegs::new(),
+        }
     }
 
     /// Every walker, listed or not.
@@ -157,6 +163,23 @@ impl Tracks {
     ) {
         self.walkers
             .update(frame, stamp_s, persons, &mut self.next_id, &cfg.motion);
+    }
+
+    /// One frame's leg candidates (map frame; [`crate::legs::legs_in_map`]): those standing
+    /// where leg-sized things stand still are left out ([`StillLegs`]; `legs` keeps the
+    /// rest), the rest paired into person candidates ([`crate::legs::pair`]) and tracked
+    /// ([`Tracks::update_walkers`]).
+    pub fn update_legs(
+        &mut self,
+        frame: u64,
+        stamp_s: f64,
+        legs: &mut Vec<Point2, MAX_LEGS>,
+        leg_cfg: &LegConfig,
+        cfg: &TrackConfig,
+    ) {
+        self.walkers.still.filter(frame, legs);
+        let persons = crate::legs::pair(legs, leg_cfg);
+        self.update_walkers(frame, stamp_s, &persons, cfg);
     }
 
     /// The walker table.
