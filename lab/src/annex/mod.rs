@@ -83,7 +83,12 @@ pub fn generate(seed: u64, seconds: f64, tour: bool, lidar: LidarModel) -> Gener
         if rng.random_bool(0.6) {
             let mut others = plan.clone();
             others.pieces.remove(i);
-            if let Some(q) = others.free_point(&mut rng, 0.7) {
+            // Not on to the robot (`world_eval::sim_family::MOVE_ROBOT_CLEAR_M`).
+            let clear = crate::world_eval::sim_family::MOVE_ROBOT_CLEAR_M;
+            if let Some(q) = (0..20)
+                .filter_map(|_| others.free_point(&mut rng, 0.7))
+                .find(|q| q.distance(start_xy) >= clear)
+            {
                 let old = &plan.pieces[i];
                 let c = old.centre();
                 let shift = |p: Point2| Point2::new(p.x - c.x + q.x, p.y - c.y + q.y);
