@@ -49,6 +49,11 @@ pub struct GeneratedRun {
     pub truth: RunTruth,
 }
 
+/// Closest a moved piece's centre is put to where the robot starts, m, here and in the
+/// simulator's families: a piece carried on to the robot (a chair 0.14 m from the LiDAR, inside
+/// the robot's body, in sim-4242 run 0) is no room anyone makes.
+pub const MOVE_ROBOT_CLEAR_M: f32 = 1.0;
+
 /// Generates annex run `seed`: `seconds` long, touring or turning in place, from `lidar`.
 pub fn generate(seed: u64, seconds: f64, tour: bool, lidar: LidarModel) -> GeneratedRun {
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
@@ -83,11 +88,9 @@ pub fn generate(seed: u64, seconds: f64, tour: bool, lidar: LidarModel) -> Gener
         if rng.random_bool(0.6) {
             let mut others = plan.clone();
             others.pieces.remove(i);
-            // Not on to the robot (`world_eval::sim_family::MOVE_ROBOT_CLEAR_M`).
-            let clear = crate::world_eval::sim_family::MOVE_ROBOT_CLEAR_M;
             if let Some(q) = (0..20)
                 .filter_map(|_| others.free_point(&mut rng, 0.7))
-                .find(|q| q.distance(start_xy) >= clear)
+                .find(|q| q.distance(start_xy) >= MOVE_ROBOT_CLEAR_M)
             {
                 let old = &plan.pieces[i];
                 let c = old.centre();

@@ -12,8 +12,8 @@ use sim::scenario::{Frame, Scenario};
 use sim::world::grid::Grid;
 use sim::world::{ObjectTruth, Prim, RoomKind, Shape, Surface, World, WorldConfig};
 
-use crate::annex::GeneratedRun;
 use crate::annex::sensor::passes_through;
+use crate::annex::{GeneratedRun, MOVE_ROBOT_CLEAR_M};
 use crate::run_truth::{Door, FrameTruth, Furniture, Move, Person, RunTruth, VISIBLE_RETURNS};
 
 /// Salt of the move's own random stream, so a run's world, robot and LiDAR are the same
@@ -23,11 +23,6 @@ const MOVE_SALT: u64 = 0x4D0F_E5A1_7C3B_9D21;
 /// Shortest distance a moved piece is carried, m: farther than the world model's gate, so its
 /// old place is left empty rather than the piece nudged.
 const MOVE_MIN_M: f32 = 1.5;
-
-/// Closest a moved piece's centre is put to where the robot starts, m: a piece carried on to
-/// the robot (a chair 0.14 m from the LiDAR, inside the robot's body, in sim-4242 run 0) is no
-/// room anyone makes.
-pub const MOVE_ROBOT_CLEAR_M: f32 = 1.0;
 
 /// Most people walking in one run (0 to this many, drawn per run).
 const MAX_WALKERS: usize = 2;
