@@ -40,30 +40,25 @@ pub const STILL_SCORE: f32 = 4.0;
 pub struct Spot {
     /// Where, map frame (fixed where first seen).
     pub at: Point2,
-    /// Decayed count of the revolutions it was seen in, as of `frame`.
+    /// Decayed count of the revolutions it was seen in, as of [`StillLegs`]' last revolution.
     pub score: f32,
-    /// The revolution `score` was last brought up to date.
-    pub frame: u64,
-}
-
-impl Spot {
-    /// The score as of `frame`.
-    fn score_at(&self, frame: u64) -> f32 {
-        let gap = frame.saturating_sub(self.frame).min(64) as i32;
-        self.score * libm::powf(DECAY, gap as f32)
-    }
 }
 
 /// The still places.
 #[derive(Debug, Clone, Default)]
 pub struct StillLegs {
     spots: Vec<Spot, MAX_SPOTS>,
+    /// The revolution every spot's score was last brought up to date to.
+    frame: u64,
 }
 
 impl StillLegs {
     /// No place known.
     pub const fn new() -> Self {
-        StillLegs { spots: Vec::new() }
+        StillLegs {
+            spots: Vec::new(),
+            frame: 0,
+        }
     }
 
     /// Every spot.
@@ -76,10 +71,12 @@ impl StillLegs {
     pub fn filter<const N: usize>(&mut self, frame: u64, legs: &mut Vec<Point2, N>) {
         legs.retain(|p| p.x.is_finite() && p.y.is_finite());
         // Bring the scores up to date; a spot seen this revolution gains one, once.
+        let gap = frame.saturating_sub(self.frame).min(64) as f32;
+        let kept = libm::powf(DECAY, gap);
         for s in self.spots.iter_mut() {
-            s.score = s.score_at(frame);
-            s.frame = frame;
+            s.score *= kept;
         }
+        self.frame = frame;
         let mut seen = [false; MAX_SPOTS];
         for p in legs.iter() {
             let near = (0..self.spots.len())
@@ -93,11 +90,7 @@ impl StillLegs {
             match near {
                 Some(i) => seen[i] = true,
                 None => {
-                    let spot = Spot {
-                        at: *p,
-                        score: 0.0,
-                        frame,
-                    };
+                    let spot = Spot { at: *p, score: 0.0 };
                     if self.spots.is_full() {
                         // The weakest gives way (not one seen this revolution).
                         if let Some(w) = (0..self.spots.len())

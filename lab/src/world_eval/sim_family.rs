@@ -149,10 +149,10 @@ pub fn generate(seed: u64, i: usize, seconds: f64, varied: f64) -> GeneratedRun 
     let cfg = scenario_config(i, &world);
     let run_seed = scenario_seed(seed, i);
     let mut s = Scenario::new(run_seed, &cfg);
-    let to_map = s.robot_start_pose().inverse();
+    let start = s.robot_start_pose();
+    let to_map = start.inverse();
     let n = (seconds * 5.0) as usize;
     let n_obj = s.world.objects.len();
-    let start = s.robot_start_pose();
     let planned = plan_move(&s.world, run_seed, n, Point2::new(start.x, start.y));
     s.add_people(run_seed, MAX_WALKERS);
     let old_footprint = planned.as_ref().map(|m| s.world.objects[m.piece].footprint);
