@@ -192,6 +192,11 @@ impl Motion {
             && self.still_run >= cfg.still_frames
     }
 
+    /// Seconds from the first observation to the last.
+    pub fn age_s(&self) -> f32 {
+        (self.stamp_s - self.first_s) as f32
+    }
+
     /// Filtered speed, m/s.
     pub fn speed(&self) -> f32 {
         libm::sqrtf(self.vel.x * self.vel.x + self.vel.y * self.vel.y)

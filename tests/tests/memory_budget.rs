@@ -149,6 +149,16 @@ fn buffers_in_code() -> Vec<(&'static str, usize, usize)> {
             size_of::<perception::tracks::Walker>(),
         ),
         (
+            "perception::free_floor::COUNT_WORDS",
+            perception::free_floor::COUNT_WORDS,
+            size_of::<u32>(),
+        ),
+        (
+            "perception::free_floor::WORDS",
+            perception::free_floor::WORDS,
+            size_of::<u32>(),
+        ),
+        (
             "perception::still_legs::MAX_SPOTS",
             perception::still_legs::MAX_SPOTS,
             size_of::<perception::still_legs::Spot>(),

@@ -279,14 +279,23 @@ pub fn score_run(truth: &RunTruth, lines: &[Line], tally: &mut Tally) {
                                 }
                                 tally.phantoms_where[phantom_place(truth, &alive, o.at)] += 1;
                             }
-                            if main && people.iter().any(|p| p.at.distance(o.at) <= PERSON_M) {
+                            let person = people
+                                .iter()
+                                .filter(|p| p.at.distance(o.at) <= PERSON_M)
+                                .min_by(|a, b| a.at.distance(o.at).total_cmp(&b.at.distance(o.at)));
+                            if let (true, Some(p)) = (main, person) {
                                 tally.people_as_furniture += 1;
                                 tally.people_reports.push(format!(
-                                    "frame {}: id {} {} ({})",
+                                    "frame {}: id {} {} ({}) at ({:.2}, {:.2}), person {} at ({:.2}, {:.2})",
                                     fi,
                                     o.id,
                                     c.map_or("?", ObjectClass::as_str),
-                                    ["A", "B", "AB"][o.source.min(2)]
+                                    ["A", "B", "AB"][o.source.min(2)],
+                                    o.at.x,
+                                    o.at.y,
+                                    p.id,
+                                    p.at.x,
+                                    p.at.y
                                 ));
                             }
                         } else if main && !near.any(|f| Some(f.class) == c) {

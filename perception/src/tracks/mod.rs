@@ -28,6 +28,8 @@
 //!    [`TrackConfig::confirm_hits`] hits and existence above [`TrackConfig::confirm_existence`],
 //!    and, unless both methods agreed on it in one frame, [`TrackConfig::single_method_hits`]
 //!    hits in at least [`TrackConfig::single_method_rate`] of the frames it was in view;
+//!    furniture born where the rays had shown the floor empty ([`FreeFloor`], marked from every
+//!    revolution's rays) must also have been seen for [`TrackConfig::appeared_settle_s`];
 //!    it is deleted when existence falls below [`TrackConfig::delete_existence`], or when a
 //!    tentative track goes unseen for [`TrackConfig::tentative_frames`]. A track out of view
 //!    keeps its state: an object behind the robot is still in the room.
@@ -36,19 +38,23 @@
 //!    [`TrackConfig::min_desk_likelihood`]) is not reported ([`Track::unlikely`],
 //!    `likelihood.rs`).
 //!
-//! Files: `merge.rs` (one object seen twice), `negative.rs` (what the rays say), `walkers.rs`
-//! (the leg detector's tracks), `door_marks.rs` (what the map's walls say of door frames),
-//! `outline_marks.rs` (what a box track's returns say of its shape), `likelihood.rs`.
+//! Files: `association.rs` (which observation updates which track), `merge.rs` (one object
+//! seen twice), `negative.rs` (what the rays say), `walkers.rs` (the leg detector's tracks),
+//! `door_marks.rs` (what the map's walls say of door frames), `outline_marks.rs` (what a box
+//! track's returns say of its shape), `likelihood.rs`.
 
 use heapless::Vec;
 
 use crate::calibration::Calibration;
 use crate::class::ObjectClass;
+use crate::free_floor::FreeFloor;
 use crate::fusion::{Evidence, FrameObject};
 use crate::geometry::{Point2, Pose2};
 use crate::motion::{Motion, MotionConfig};
 use crate::sight::BINS;
+use association::{cheapest, class_cost};
 
+mod association;
 mod door_marks;
 mod likelihood;
 mod merge;
@@ -124,6 +130,11 @@ pub struct TrackConfig {
     /// where they should be) speaks against it, not the methods' silence. A doorway does not
     /// move away; 0: never.
     pub door_hold_hits: u32,
+    /// Seconds a piece of furniture must be seen, and still, before it is reported when it
+    /// appeared on floor the LiDAR had seen empty ([`FreeFloor`]): where a person walks and
+    /// stands for a moment, not where furniture stood when the robot first looked. Below
+    /// [`MotionConfig::settle_s`]: no extra wait.
+    pub appeared_settle_s: f32,
 }
 
 impl Default for TrackConfig {
@@ -150,6 +161,7 @@ impl Default for TrackConfig {
             min_likelihood: 0.0,
             min_desk_likelihood: 0.0,
             door_hold_hits: 0,
+            appeared_settle_s: 0.0,
         }
     }
 }
@@ -188,6 +200,9 @@ pub struct Track {
     pub width_m: f32,
     /// Position and velocity from the observations alone; whether it walks.
     pub motion: Motion,
+    /// Furniture that appeared on floor seen empty before ([`FreeFloor`]): it waits
+    /// [`TrackConfig::appeared_settle_s`] before it is reported.
+    pub born_on_free: bool,
     /// A door frame the map's walls have shown as a doorway (a gap seen through): an opening
     /// in a wall, which rays passing through do not speak against.
     pub anchored: bool,
@@ -254,7 +269,9 @@ impl Track {
 /// both methods agreed on it in one frame, more hits and a steady detection rate while in
 /// view (Method A seeing it once and Method B once, in different frames, is not agreement).
 fn earns_report(t: &Track, cfg: &TrackConfig) -> bool {
+    let waited = !t.born_on_free || t.motion.age_s() >= cfg.appeared_settle_s;
     let base = t.motion.settled(&cfg.motion)
+        && waited
         && t.hits >= cfg.confirm_hits
         && t.existence >= cfg.confirm_existence
         && !t.door_at_corner();
@@ -299,45 +316,12 @@ pub struct Tracks {
     next_id: u32,
     stats: TrackStats,
     walkers: Walkers,
+    floor: FreeFloor,
 }
 
 impl Default for Tracks {
     fn default() -> Self {
         Self::new()
-    }
-}
-
-/// The cheapest (track `i`, observation `k`) pair neither of which is taken yet (`matched`,
-/// `used`), by `cost` (`None`: they cannot be one); ties go to the first found, tracks in
-/// order, then observations. Both tables associate greedily on the global minimum with it.
-fn cheapest(
-    matched: &[bool],
-    used: &[bool],
-    tracks: usize,
-    obs: usize,
-    cost: impl Fn(usize, usize) -> Option<f32>,
-) -> Option<(usize, usize)> {
-    let mut best: Option<(f32, usize, usize)> = None;
-    for i in (0..tracks).filter(|&i| !matched[i]) {
-        for k in (0..obs).filter(|&k| !used[k]) {
-            if let Some(c) = cost(i, k)
-                && best.is_none_or(|b| c < b.0)
-            {
-                best = Some((c, i, k));
-            }
-        }
-    }
-    best.map(|(_, i, k)| (i, k))
-}
-
-/// Class compatibility cost: `None` when the two cannot be one object.
-fn class_cost(track: ObjectClass, obs: ObjectClass, cfg: &TrackConfig) -> Option<f32> {
-    use ObjectClass::DoorFrame;
-    match (track == DoorFrame, obs == DoorFrame) {
-        (true, true) => Some(0.0),
-        (false, false) if track == obs => Some(0.0),
-        (false, false) => Some(cfg.class_change_cost_m),
-        _ => None,
     }
 }
 
@@ -356,6 +340,7 @@ impl Tracks {
                 merged: 0,
             },
             walkers: Walkers::new(),
+            floor: FreeFloor::new(),
         }
     }
 
@@ -498,6 +483,7 @@ impl Tracks {
                 confirmed: false,
                 width_m: 0.0,
                 motion: Motion::new(o.centre, stamp_s),
+                born_on_free: o.class != ObjectClass::DoorFrame && self.floor.seen_free(o.centre),
                 anchored: false,
                 box_wide_views: 0,
                 narrow_views: 0,
@@ -513,6 +499,10 @@ impl Tracks {
                 self.next_id = self.next_id.wrapping_add(1);
                 self.stats.created += 1;
             }
+        }
+        // What this revolution saw through (after the new tracks: it speaks of the next ones).
+        if pose_ok && cfg.appeared_settle_s > 0.0 {
+            self.floor.mark(lidar, ranges, cfg.max_range_m);
         }
     }
 
@@ -1439,6 +1429,47 @@ mod test {
             }
         }
         assert!(gone.is_some_and(|f| f < 30), "deleted at {gone:?}");
+    }
+
+    #[test]
+    fn furniture_that_appears_on_floor_seen_empty_waits_longer() {
+        let cfg = TrackConfig {
+            appeared_settle_s: 3.0,
+            ..TrackConfig::default()
+        };
+        let seen_through = ranges(4.0);
+        let a_box = [obs(ObjectClass::Box, 2.0, 0.0, 0.8, Evidence::AB)];
+        // The frame from which it is reported, seen in every frame from frame `from` on.
+        let reported_from = |from: u64, cfg: &TrackConfig| {
+            let mut t = Tracks::new();
+            for f in 0..from {
+                step(&mut t, f, &[], &Pose2::IDENTITY, &seen_through, cfg);
+            }
+            (from..from + 40).find(|&f| {
+                step(&mut t, f, &a_box, &Pose2::IDENTITY, &seen_through, cfg);
+                t.confirmed().next().is_some()
+            })
+        };
+        // There from the first look: reported after the usual second (5 revolutions).
+        assert_eq!(reported_from(0, &cfg), Some(5));
+        // Appearing where the rays had passed: 3 s (15 revolutions) from its first sighting.
+        assert_eq!(reported_from(10, &cfg), Some(25));
+        // Without the rule it waits the usual second there too.
+        let plain = TrackConfig {
+            appeared_settle_s: 0.0,
+            ..cfg
+        };
+        assert_eq!(reported_from(10, &plain), Some(15));
+        // A door frame stands in a doorway, which rays pass: no extra wait.
+        let door = [obs(ObjectClass::DoorFrame, 2.0, 0.0, 0.8, Evidence::AB)];
+        let mut t = Tracks::new();
+        for f in 0..10 {
+            step(&mut t, f, &[], &Pose2::IDENTITY, &seen_through, &cfg);
+        }
+        for f in 10..16 {
+            step(&mut t, f, &door, &Pose2::IDENTITY, &seen_through, &cfg);
+        }
+        assert!(t.confirmed().next().is_some());
     }
 
     #[test]

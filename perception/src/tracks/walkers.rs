@@ -93,7 +93,7 @@ impl Walkers {
             *a = w.motion.predict(stamp_s, cfg);
         }
         while let Some((i, k)) =
-            super::cheapest(&matched, &used, self.list.len(), persons.len(), |i, k| {
+            super::association::cheapest(&matched, &used, self.list.len(), persons.len(), |i, k| {
                 let (w, p) = (&self.list[i], &persons[k]);
                 let d = w
                     .motion
