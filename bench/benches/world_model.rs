@@ -137,6 +137,16 @@ fn world(c: &mut Criterion) {
             black_box(t.all().len())
         })
     });
+    // The seen-empty floor's share of the update: one revolution's rays marked.
+    group.bench_function("free_floor_mark", |b| {
+        let mut floor = perception::free_floor::FreeFloor::new();
+        let mut k = 0usize;
+        b.iter(|| {
+            let f = &frames[k % FRAMES];
+            k += 1;
+            floor.mark(&f.lidar, black_box(&f.ranges), cfg.max_range_m);
+        })
+    });
     let centres: Vec<Point2> = warm.all().iter().map(|t| t.centre).collect();
     group.bench_function("hungarian_association_peer", |b| {
         let mut k = 0usize;

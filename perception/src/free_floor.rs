@@ -104,13 +104,22 @@ impl FreeFloor {
             return;
         }
         self.this_rev = [0; WORDS];
-        // In cell units from the square's corner: a cell is the integer part, no floor call.
+        // In cell units from the square's corner, fixed point (16 fractional bits): a step is
+        // an integer add, the cell its integer part, and a negative position fails the
+        // unsigned bound.
+        const ONE: f32 = 65_536.0;
         let inv = 1.0 / CELL_M;
         let (ox, oy) = (
             (lidar.x + HALF_EXTENT_M) * inv,
             (lidar.y + HALF_EXTENT_M) * inv,
         );
+        // The square, with a margin for the farthest a ray reaches: beyond it nothing marks.
+        let far = (max_range_m.min(2.0 * HALF_EXTENT_M) * inv).max(0.0);
         let side = SIDE as f32;
+        if !(ox + far >= 0.0 && oy + far >= 0.0 && ox - far < side && oy - far < side) {
+            return;
+        }
+        let bound = (SIDE as u32) << 16;
         for (d, &r) in ranges.iter().enumerate() {
             if !(r > 0.0 && r.is_finite()) {
                 continue;
@@ -120,16 +129,21 @@ impl FreeFloor {
                 continue;
             }
             let (s, c) = libm::sincosf(lidar.theta + (d as f32).to_radians());
-            let (dx, dy) = (c * STEP_M * inv, s * STEP_M * inv);
-            let (mut fx, mut fy) = (ox + c * FROM_M * inv, oy + s * FROM_M * inv);
+            let (dx, dy) = (
+                (c * STEP_M * inv * ONE) as i32,
+                (s * STEP_M * inv * ONE) as i32,
+            );
+            let mut fx = ((ox + c * FROM_M * inv) * ONE) as i32;
+            let mut fy = ((oy + s * FROM_M * inv) * ONE) as i32;
             let steps = ((reach - FROM_M) / STEP_M) as usize + 1;
             for _ in 0..steps {
-                if fx >= 0.0 && fy >= 0.0 && fx < side && fy < side {
-                    let k = fy as usize * SIDE + fx as usize;
+                let (ux, uy) = (fx as u32, fy as u32);
+                if ux < bound && uy < bound {
+                    let k = (uy >> 16) as usize * SIDE + (ux >> 16) as usize;
                     self.this_rev[k / 32] |= 1 << (k % 32);
                 }
-                fx += dx;
-                fy += dy;
+                fx = fx.wrapping_add(dx);
+                fy = fy.wrapping_add(dy);
             }
         }
         // Each crossed cell counts once for the revolution, however many rays crossed it.
