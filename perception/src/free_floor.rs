@@ -1,9 +1,9 @@
 //! Where the floor has been seen empty: a fixed grid over the map around the robot's start,
-//! counting the revolutions whose rays passed a cell well short of their return. The world model asks it where a
-//! new track appears: furniture stands where it stood when the robot first looked, while a
-//! person walks on to floor the LiDAR has already seen through, and may stand there for a
-//! moment. A track born on such floor has to stay for longer before it is reported
-//! ([`crate::tracks::TrackConfig::appeared_settle_s`]). `no_std`, allocation-free.
+//! counting the revolutions whose rays passed a cell well short of their return. The world
+//! model asks it where a new track appears: furniture stands where it stood when the robot
+//! first looked, while a person walks on to floor the LiDAR has already seen through, and may
+//! stand there for a moment. A track born on such floor has to stay for longer before it is
+//! reported ([`crate::tracks::TrackConfig::appeared_settle_s`]). `no_std`, allocation-free.
 //!
 //! Cells are [`CELL_M`] across, [`SIDE`] a side, centred on the map's origin (the robot's start):
 //! ±[`HALF_EXTENT_M`] m. Outside it nothing is known, and [`FreeFloor::seen_free`] says no.
@@ -86,7 +86,7 @@ impl FreeFloor {
         (inside(cx) && inside(cy)).then(|| cy as usize * SIDE + cx as usize)
     }
 
-    /// Revolutions whose rays crossed the cell of `p` (0–3).
+    /// Revolutions whose rays crossed cell `k` (0–3).
     fn count(&self, k: usize) -> u32 {
         (self.counts[k / 16] >> ((k % 16) * 2)) & 3
     }
@@ -153,9 +153,8 @@ impl FreeFloor {
                 let b = rest.trailing_zeros() as usize;
                 rest &= rest - 1;
                 let k = w * 32 + b;
-                let shift = (k % 16) * 2;
-                if (self.counts[k / 16] >> shift) & 3 < 3 {
-                    self.counts[k / 16] += 1 << shift;
+                if self.count(k) < 3 {
+                    self.counts[k / 16] += 1 << ((k % 16) * 2);
                 }
             }
         }

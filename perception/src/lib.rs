@@ -28,7 +28,7 @@
 //! | [`fusion`]     | one frame's objects from both methods: A's, and B's joined or added |
 //! | [`calibration`] | what a detection's score means: a measured probability per source and class |
 //! | [`sight`]      | what a revolution showed of a footprint (hidden, in view, seen empty) or a doorway |
-//! | [`free_floor`] | where the floor has been seen empty: a bitmap of the map around the start |
+//! | [`free_floor`] | where the floor has been seen empty: revolutions counted per cell around the start |
 //! | [`still_legs`] | where leg-sized things stand still: a background for the leg detector |
 //! | [`motion`]     | a track's alpha–beta motion filter; walking legs told from furniture |
 //! | [`legs`]       | people's legs in a revolution: leg-sized free-standing blobs, paired |

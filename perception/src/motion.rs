@@ -187,7 +187,7 @@ impl Motion {
     /// Whether it may be reported as furniture: not moving, seen for long enough, still now.
     pub fn settled(&self, cfg: &MotionConfig) -> bool {
         !self.moving
-            && (self.stamp_s - self.first_s) as f32 >= cfg.settle_s
+            && self.age_s() >= cfg.settle_s
             && self.speed() < cfg.still_speed
             && self.still_run >= cfg.still_frames
     }

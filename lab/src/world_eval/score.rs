@@ -279,11 +279,15 @@ pub fn score_run(truth: &RunTruth, lines: &[Line], tally: &mut Tally) {
                                 }
                                 tally.phantoms_where[phantom_place(truth, &alive, o.at)] += 1;
                             }
-                            let person = people
-                                .iter()
-                                .filter(|p| p.at.distance(o.at) <= PERSON_M)
-                                .min_by(|a, b| a.at.distance(o.at).total_cmp(&b.at.distance(o.at)));
-                            if let (true, Some(p)) = (main, person) {
+                            let nearest_person = || {
+                                people
+                                    .iter()
+                                    .filter(|p| p.at.distance(o.at) <= PERSON_M)
+                                    .min_by(|a, b| {
+                                        a.at.distance(o.at).total_cmp(&b.at.distance(o.at))
+                                    })
+                            };
+                            if let Some(p) = main.then(nearest_person).flatten() {
                                 tally.people_as_furniture += 1;
                                 tally.people_reports.push(format!(
                                     "frame {}: id {} {} ({}) at ({:.2}, {:.2}), person {} at ({:.2}, {:.2})",
