@@ -26,8 +26,8 @@ pub fn returns(ranges: &[f32; BINS]) -> [Option<Point2>; BINS] {
 pub enum View {
     /// Out of range, inside the robot's own footprint, or behind something nearer.
     Hidden,
-    /// In plain view: the rays reach it (they end inside its footprint).
-    Plain,
+    /// In plain view: the rays reach it (they end inside its footprint); how many did.
+    Plain(u32),
     /// Seen empty: no ray ended in it, at least two crossed it and returned from beyond, and
     /// no fewer than ended in front of it (a footprint partly behind something nearer is still
     /// seen through where the rays reach it). [`footprint_view`] also counts rays with no
@@ -109,7 +109,7 @@ fn seen(across: Option<Across>, none_passes: bool) -> View {
         {
             View::Empty
         }
-        Some(a) if a.inside > 0 && a.inside >= a.before => View::Plain,
+        Some(a) if a.inside > 0 && a.inside >= a.before => View::Plain(a.inside),
         _ => View::Hidden,
     }
 }
@@ -171,7 +171,7 @@ pub fn doorway_view(
     let no_jambs = whole.is_some_and(|a| a.inside == 0 && a.before == 0 && a.beyond >= 2);
     let whole_hidden = whole.is_none_or(|a| !(a.inside > 0 && a.inside >= a.before));
     match middle {
-        View::Plain => DoorView::Closed,
+        View::Plain(_) => DoorView::Closed,
         _ if no_jambs => DoorView::NoJambs,
         View::Hidden if whole_hidden => DoorView::Hidden,
         _ => DoorView::Open,
@@ -199,7 +199,7 @@ mod test {
         r[5] = 2.1;
         assert_eq!(look(&r), View::Hidden);
         r[350..BINS].fill(3.2);
-        assert_eq!(look(&r), View::Plain);
+        assert!(matches!(look(&r), View::Plain(_)));
         r[350..BINS].fill(1.0);
         // Mostly behind the pillar: too little seen to call it empty.
         r[5] = 3.2;
@@ -227,7 +227,7 @@ mod test {
         // A ray that ends in it: in plain view, whatever the others did.
         let mut r = none;
         r[2] = 2.1;
-        assert_eq!(near(&r), View::Plain);
+        assert!(matches!(near(&r), View::Plain(_)));
         // Behind something nearer in most of its bins: hidden.
         let mut r = none;
         r[350..BINS].fill(1.0);

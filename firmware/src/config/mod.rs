@@ -309,6 +309,9 @@ pub struct WorldSettings {
     /// `settle_s`. 3 by default: on the tuning runs it halved the reports of walking people as
     /// furniture at no cost in IDF1 (docs/world.md).
     pub appeared_settle_s: f32,
+    /// Returns a piece's footprint must give in a revolution for the methods' silence to
+    /// count against it (`perception::tracks::TrackConfig::miss_min_returns`).
+    pub miss_min_returns: u32,
 }
 
 impl Default for WorldSettings {
@@ -323,6 +326,7 @@ impl Default for WorldSettings {
             desk_min_likelihood: 0.6,
             door_hold_hits: 20,
             appeared_settle_s: 3.0,
+            miss_min_returns: 1,
         }
     }
 }
@@ -351,6 +355,7 @@ impl WorldSettings {
         if self.appeared_settle_s.is_finite() {
             c.appeared_settle_s = self.appeared_settle_s.max(0.0);
         }
+        c.miss_min_returns = self.miss_min_returns.max(1);
         c
     }
 }
@@ -653,6 +658,15 @@ mod test {
         assert_eq!(Config::default().world.tracks().appeared_settle_s, 3.0);
         let w: Config = toml::from_str("[world]\nappeared_settle_s = 0\n").unwrap();
         assert_eq!(w.world.tracks().appeared_settle_s, 0.0);
+        assert_eq!(Config::default().world.tracks().miss_min_returns, 1);
+        let w: Config = toml::from_str("[world]\nmiss_min_returns = 3\n").unwrap();
+        assert_eq!(w.world.tracks().miss_min_returns, 3);
+        let w: Config = toml::from_str("[world]\nmiss_min_returns = 0\n").unwrap();
+        assert_eq!(
+            w.world.tracks().miss_min_returns,
+            1,
+            "a miss needs a return"
+        );
         let w: Config = toml::from_str("[world]\ndoor_hold_hits = 0\n").unwrap();
         assert_eq!(w.world.tracks().door_hold_hits, 0);
         let bad: Config = toml::from_str("[method_b]\nconf = 1.5\n").unwrap();

@@ -100,6 +100,10 @@ pub struct TrackConfig {
     /// Existence lost in a frame whose revolution had the track in plain view (in range, its
     /// bearing not blocked by anything nearer) and no observation matched it.
     pub miss_loss: f32,
+    /// Returns its footprint must give in a revolution for that revolution to count as a miss
+    /// (and as a view): fewer, and no method could have found it there (a far piece the
+    /// LiDAR barely reaches, a dark one that mostly drops out), so its silence says nothing.
+    pub miss_min_returns: u32,
     /// Hits a track seen by one method only needs before it is reported (both methods: just
     /// [`TrackConfig::confirm_hits`]): one method's repeated mistake is the commonest phantom.
     pub single_method_hits: u32,
@@ -149,6 +153,7 @@ impl Default for TrackConfig {
             hit_gain: 1.0,
             free_loss: 1.0,
             miss_loss: 0.7,
+            miss_min_returns: 1,
             single_method_hits: 8,
             single_method_rate: 0.6,
             existence_cap: 6.0,
@@ -1006,6 +1011,40 @@ mod test {
             "{seen} → {after}"
         );
         assert!(cfg.miss_loss < cfg.free_loss);
+    }
+
+    #[test]
+    fn a_footprint_that_returned_too_little_for_a_method_is_not_missed() {
+        let mut t = Tracks::new();
+        let cfg = TrackConfig {
+            miss_min_returns: 3,
+            ..quick()
+        };
+        // A chair 2 m ahead of which this revolution caught two legs, then three.
+        let mut scan = ranges(3.4);
+        scan[4] = 2.1;
+        scan[356] = 1.9;
+        for f in 0..4 {
+            step(
+                &mut t,
+                f,
+                &[obs(CHAIR, 2.0, 0.0, 0.9, Evidence::A)],
+                &Pose2::IDENTITY,
+                &scan,
+                &cfg,
+            );
+        }
+        let (seen, views) = (t.all()[0].existence, t.all()[0].views);
+        step(&mut t, 4, &[], &Pose2::IDENTITY, &scan, &cfg);
+        assert_eq!(t.all()[0].existence, seen);
+        assert_eq!(t.all()[0].views, views, "not a view either");
+        scan[0] = 2.0;
+        step(&mut t, 5, &[], &Pose2::IDENTITY, &scan, &cfg);
+        let after = t.all()[0].existence;
+        assert!(
+            (seen - after - cfg.miss_loss).abs() < 1e-6,
+            "{seen} → {after}"
+        );
     }
 
     #[test]

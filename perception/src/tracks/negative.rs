@@ -76,8 +76,13 @@ pub(super) fn unobserved(
         };
         match look(t.centre, t.radius(), lidar, ranges, cfg.max_range_m) {
             View::Empty => (cfg.free_loss, true),
-            View::Plain if looked_for => (cfg.miss_loss, true),
-            View::Plain | View::Hidden => (0.0, false),
+            // Too few returns for any method to have found it: not a miss — unless it appeared
+            // where the floor had been seen empty (legs that stopped, like as not, not a piece
+            // of furniture the LiDAR barely reaches).
+            View::Plain(n) if looked_for && (n >= cfg.miss_min_returns || t.born_on_free) => {
+                (cfg.miss_loss, true)
+            }
+            View::Plain(_) | View::Hidden => (0.0, false),
         }
     };
     if in_view {
