@@ -9,7 +9,9 @@
 //!   seen the track looked in this frame. A track only Method B has seen is not missed in a
 //!   frame Method B did not run in (skipped by the overrun policy, or on its own thread and
 //!   not finished: a Pi 3's schedule), and that frame does not count against its detection
-//!   rate either.
+//!   rate either. Nor is it missed where its footprint returned fewer rays than
+//!   [`TrackConfig::miss_min_returns`] (too few for a method to find it by), unless it was
+//!   born on floor seen empty.
 
 use super::{Track, TrackConfig};
 use crate::class::ObjectClass;
