@@ -310,10 +310,9 @@ pub struct WorldSettings {
     /// furniture at no cost in IDF1 (docs/world.md).
     pub appeared_settle_s: f32,
     /// Returns a piece's footprint must give in a revolution for the methods' silence to
-    /// count against it (`perception::tracks::TrackConfig::miss_min_returns`): a single return
-    /// is too few for either method to find a piece by. 2 by default: on the
-    /// held-out runs of every family it raised recall and IDF1 and reported no more walking
-    /// people as furniture; 3 reported some (docs/world.md).
+    /// count against it (`perception::tracks::TrackConfig::miss_min_returns`). 2 by default:
+    /// held out, it raised recall and IDF1 in every family, with no more walking people
+    /// reported as furniture; 3 reported some (docs/world.md).
     pub miss_min_returns: u32,
 }
 
