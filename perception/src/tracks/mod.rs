@@ -984,11 +984,10 @@ mod test {
         assert!(t.all()[0].confirmed);
     }
 
-    #[test]
-    fn legs_inside_the_footprint_are_not_seen_as_empty() {
+    /// A chair 2 m ahead, tracked over four frames of a revolution whose rays pass between its
+    /// legs (to 3.4 m) except two on legs: the table and that revolution.
+    fn chair_on_two_legs(cfg: &TrackConfig) -> (Tracks, [f32; BINS]) {
         let mut t = Tracks::new();
-        let cfg = quick();
-        // A chair 2 m ahead: rays pass between its legs (to 3.4 m) except two on legs.
         let mut scan = ranges(3.4);
         scan[4] = 2.1;
         scan[356] = 1.9;
@@ -999,9 +998,16 @@ mod test {
                 &[obs(CHAIR, 2.0, 0.0, 0.9, Evidence::A)],
                 &Pose2::IDENTITY,
                 &scan,
-                &cfg,
+                cfg,
             );
         }
+        (t, scan)
+    }
+
+    #[test]
+    fn legs_inside_the_footprint_are_not_seen_as_empty() {
+        let cfg = quick();
+        let (mut t, scan) = chair_on_two_legs(&cfg);
         let seen = t.all()[0].existence;
         // Not detected for a frame while in plain view: a missed detection, not an empty place.
         step(&mut t, 4, &[], &Pose2::IDENTITY, &scan, &cfg);
@@ -1015,25 +1021,12 @@ mod test {
 
     #[test]
     fn a_footprint_that_returned_too_little_for_a_method_is_not_missed() {
-        let mut t = Tracks::new();
         let cfg = TrackConfig {
             miss_min_returns: 3,
             ..quick()
         };
-        // A chair 2 m ahead of which this revolution caught two legs, then three.
-        let mut scan = ranges(3.4);
-        scan[4] = 2.1;
-        scan[356] = 1.9;
-        for f in 0..4 {
-            step(
-                &mut t,
-                f,
-                &[obs(CHAIR, 2.0, 0.0, 0.9, Evidence::A)],
-                &Pose2::IDENTITY,
-                &scan,
-                &cfg,
-            );
-        }
+        // The revolution caught two of its legs, then three.
+        let (mut t, mut scan) = chair_on_two_legs(&cfg);
         let (seen, views) = (t.all()[0].existence, t.all()[0].views);
         step(&mut t, 4, &[], &Pose2::IDENTITY, &scan, &cfg);
         assert_eq!(t.all()[0].existence, seen);
