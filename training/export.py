@@ -42,7 +42,7 @@ def ultralytics_onnx(weights: Path) -> Path:
     return Path(f)
 
 
-def quantise(fp32: Path, out: Path, calib: Path, n: int) -> None:
+def quantise(fp32: Path, out: Path, calib: Path, n: int, per_channel: bool = False) -> None:
     from onnxruntime.quantization import (CalibrationDataReader, QuantFormat, QuantType,
                                           quantize_static)
 
@@ -58,7 +58,7 @@ def quantise(fp32: Path, out: Path, calib: Path, n: int) -> None:
 
     quantize_static(
         str(fp32), str(out), Reader(), quant_format=QuantFormat.QOperator,
-        op_types_to_quantize=["Conv"], per_channel=False, activation_type=QuantType.QUInt8,
+        op_types_to_quantize=["Conv"], per_channel=per_channel, activation_type=QuantType.QUInt8,
         weight_type=QuantType.QInt8,
     )
 
@@ -69,6 +69,8 @@ def main() -> None:
     ap.add_argument("--out", default="models/yolo")
     ap.add_argument("--calib", help="folder of PNGs for int8 calibration")
     ap.add_argument("--calib-images", type=int, default=256)
+    ap.add_argument("--per-channel", action="store_true",
+                    help="int8 weights per output channel (as `qat.py --per-channel` trains)")
     ap.add_argument("--full-head", action="store_true",
                     help="keep the DFL and box decoding in the graph (1x8x504)")
     a = ap.parse_args()
@@ -83,7 +85,7 @@ def main() -> None:
     print(f"wrote {fp32}")
     if a.calib:
         q = out / "umbra-yolov8n-int8.onnx"
-        quantise(fp32, q, Path(a.calib), a.calib_images)
+        quantise(fp32, q, Path(a.calib), a.calib_images, a.per_channel)
         print(f"wrote {q}")
 
 

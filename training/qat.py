@@ -52,8 +52,13 @@ def fq_act(x: torch.Tensor, lo: float, hi: float) -> torch.Tensor:
     return torch.fake_quantize_per_tensor_affine(x, scale, zero, A_MIN, A_MAX)
 
 
-def fq_weight(w: torch.Tensor) -> torch.Tensor:
-    """`w` rounded as int8 per tensor on its largest magnitude (symmetric, zero point 0)."""
+def fq_weight(w: torch.Tensor, per_channel: bool = False) -> torch.Tensor:
+    """`w` rounded as int8 on its largest magnitude (symmetric, zero point 0): per tensor, or
+    per output channel as onnxruntime's `per_channel=True` quantises a convolution's weights."""
+    if per_channel:
+        scale = (w.detach().abs().amax(dim=(1, 2, 3)) / W_MAX).clamp(min=1e-12).float()
+        zero = torch.zeros(w.shape[0], dtype=torch.int32, device=w.device)
+        return torch.fake_quantize_per_channel_affine(w, scale, zero, 0, -W_MAX, W_MAX)
     scale = max(float(w.detach().abs().max()) / W_MAX, 1e-12)
     return torch.fake_quantize_per_tensor_affine(w, scale, 0, -W_MAX, W_MAX)
 
@@ -61,24 +66,28 @@ def fq_weight(w: torch.Tensor) -> torch.Tensor:
 class QConv(Conv):
     """Ultralytics' Conv (conv, batch norm, SiLU) as the int8 export computes it."""
 
+    per_channel = False  # weights rounded per output channel (`prepare` sets it per layer)
+
     def forward(self, x):
         bn, conv = self.bn, self.conv
         g = bn.weight / torch.sqrt(bn.running_var + bn.eps)
         w = conv.weight * g.view(-1, 1, 1, 1)
         b = bn.bias - bn.running_mean * g
         r = self.q_range.tolist()
-        y = F.conv2d(fq_act(x, r[0], r[1]), fq_weight(w), b, conv.stride, conv.padding,
-                     conv.dilation, conv.groups)
+        y = F.conv2d(fq_act(x, r[0], r[1]), fq_weight(w, self.per_channel), b, conv.stride,
+                     conv.padding, conv.dilation, conv.groups)
         return self.act(fq_act(y, r[2], r[3]))
 
 
 class QConv2d(nn.Conv2d):
     """A bare convolution (the head's outputs) as the int8 export computes it."""
 
+    per_channel = False
+
     def forward(self, x):
         r = self.q_range.tolist()
-        y = F.conv2d(fq_act(x, r[0], r[1]), fq_weight(self.weight), self.bias, self.stride,
-                     self.padding, self.dilation, self.groups)
+        y = F.conv2d(fq_act(x, r[0], r[1]), fq_weight(self.weight, self.per_channel), self.bias,
+                     self.stride, self.padding, self.dilation, self.groups)
         return fq_act(y, r[2], r[3])
 
 
@@ -104,9 +113,10 @@ def calibration_tensors(folder: Path, n: int) -> list[torch.Tensor]:
 
 
 @torch.no_grad()
-def prepare(model: nn.Module, images: list[torch.Tensor]) -> int:
+def prepare(model: nn.Module, images: list[torch.Tensor], per_channel: bool = False) -> int:
     """Measures each quantised convolution's input and output range over `images` and turns it
-    into its fake-quantised class. Returns how many layers were prepared."""
+    into its fake-quantised class, its weights rounded per tensor or per output channel.
+    Returns how many layers were prepared."""
     layers = list(quantised_layers(model))
     seen: dict[str, list[float]] = {name: [0.0, 0.0, 0.0, 0.0] for name, _, _ in layers}
     hooks = []
@@ -131,6 +141,7 @@ def prepare(model: nn.Module, images: list[torch.Tensor]) -> int:
     for name, m, _ in layers:
         m.register_buffer("q_range", torch.tensor(seen[name], dtype=torch.float32))
         m.__class__ = QConv if isinstance(m, Conv) else QConv2d
+        m.per_channel = per_channel
     return len(layers)
 
 
@@ -141,6 +152,7 @@ def strip(model: nn.Module) -> int:
         if isinstance(m, (QConv, QConv2d)):
             m.__class__ = Conv if isinstance(m, QConv) else nn.Conv2d
             del m.q_range
+            m.__dict__.pop("per_channel", None)
             n += 1
     return n
 
@@ -149,11 +161,14 @@ class QATTrainer(ExactTrainer):
     """The exact-shape trainer whose model trains through the int8 rounding."""
 
     calib: list[torch.Tensor] = []
+    per_channel = False
 
     def get_model(self, cfg=None, weights=None, verbose=True):
         model = super().get_model(cfg, weights, verbose)
-        n = prepare(model, self.calib)
-        print(f"qat: {n} convolutions fake-quantised on {len(self.calib)} calibration images")
+        n = prepare(model, self.calib, self.per_channel)
+        form = "per channel" if self.per_channel else "per tensor"
+        print(f"qat: {n} convolutions fake-quantised ({form} weights) on {len(self.calib)} "
+              "calibration images")
         return model
 
 
@@ -173,6 +188,8 @@ def main() -> None:
     ap.add_argument("--init", type=Path, help="the float checkpoint to fine-tune")
     ap.add_argument("--calib", type=Path, help="folder of training PNGs (export.py's)")
     ap.add_argument("--calib-images", type=int, default=256)
+    ap.add_argument("--per-channel", action="store_true",
+                    help="round weights per output channel (export with `export.py --per-channel`)")
     ap.add_argument("--epochs", type=int, default=2)
     ap.add_argument("--batch", type=int, default=32)
     ap.add_argument("--lr0", type=float, default=1e-4)
@@ -196,6 +213,7 @@ def main() -> None:
     if not (a.data and (a.init or a.resume) and a.calib):
         ap.error("--data, --init (or --resume) and --calib are needed to train")
     qat.QATTrainer.calib = calibration_tensors(a.calib, a.calib_images)
+    qat.QATTrainer.per_channel = a.per_channel
     t0 = time.time()
     w = train_mod.train(Path(a.data), a.epochs, a.batch, a.seed, a.device, a.workers, a.name,
                         a.resume, init=a.init, lr0=a.lr0, trainer=qat.QATTrainer)

@@ -10,7 +10,8 @@ environment, `.venv/bin/python training/test_training.py DATASET/data.yaml`).
 * quantisation-aware training (`qat.py`): the shipped checkpoint with its convolutions
   fake-quantised on N calibration images must compute what onnxruntime's int8 export,
   calibrated on the same N images, computes — far closer to it than the float model is (the
-  rest is the integer accumulators' rounding, about one output step).
+  rest is the integer accumulators' rounding, about one output step), with weights rounded
+  per tensor and per output channel alike.
 """
 
 import shutil
@@ -94,7 +95,7 @@ def test_logits_head(data: Path) -> None:
     print(f"logits head: {len(images)} images, largest difference {worst:.2e}")
 
 
-def test_qat_emulates_int8(data: Path, calib: int = 32) -> None:
+def test_qat_emulates_int8(data: Path, calib: int = 32, per_channel: bool = False) -> None:
     import onnxruntime as ort
     import torch
     from ultralytics import YOLO
@@ -108,9 +109,9 @@ def test_qat_emulates_int8(data: Path, calib: int = 32) -> None:
     f32 = tmp / "m.onnx"
     logits_head.cut(ultralytics_onnx(tmp / "m.pt"), f32)
     folder = data.parent / "images" / "train"
-    quantise(f32, tmp / "m8.onnx", folder, calib)
+    quantise(f32, tmp / "m8.onnx", folder, calib, per_channel)
     model = YOLO(str(tmp / "m.pt")).model.float().eval()
-    n = qat.prepare(model, qat.calibration_tensors(folder, calib))
+    n = qat.prepare(model, qat.calibration_tensors(folder, calib), per_channel)
     run = {k: ort.InferenceSession(str(f), providers=["CPUExecutionProvider"])
            for k, f in (("fp32", f32), ("int8", tmp / "m8.onnx"))}
     emulated_off, float_off = [], []
@@ -125,11 +126,14 @@ def test_qat_emulates_int8(data: Path, calib: int = 32) -> None:
     e, fl = float(np.mean(emulated_off)), float(np.mean(float_off))
     assert n > 60, f"only {n} convolutions fake-quantised"
     assert e < 0.35 * fl, f"emulation off int8 by {e:.3f}, float by {fl:.3f}"
-    print(f"qat: {n} convolutions; mean |emulated - int8| {e:.3f}, |float - int8| {fl:.3f}")
+    form = "per channel" if per_channel else "per tensor"
+    print(f"qat ({form}): {n} convolutions; mean |emulated - int8| {e:.3f}, "
+          f"|float - int8| {fl:.3f}")
 
 
 if __name__ == "__main__":
     test_qat_emulates_int8(Path(sys.argv[1]))
+    test_qat_emulates_int8(Path(sys.argv[1]), per_channel=True)
     test_logits_head(Path(sys.argv[1]))
     test_shuffled(Path(sys.argv[1]))
     print("ok")
