@@ -20,6 +20,10 @@ images the export uses. The DFL's fixed convolution is not in the exported graph
 decodes it in float) and is left alone. Ultralytics' own QAT (ModelOpt) quantises per channel
 and exports Q/DQ nodes, which tract runs in float: not the model we ship.
 
+`--per-channel` rounds the folded weights per output channel instead, as `export.py
+--per-channel` writes them; from rt36 it did no better than per tensor (qat36 against qat36t,
+`models/README.md`), and tract runs that form 2-3 times slower on the Pis.
+
 `--strip` writes an ordinary Ultralytics checkpoint (the fake quantisation taken out, optimizer
 state dropped); `export.py` makes its fp32 and int8 files like any other's.
 """
