@@ -54,6 +54,7 @@ pub mod merge;
 pub mod method_a;
 pub mod motion;
 pub mod outline;
+pub mod outline_average;
 pub mod plausible;
 pub mod pose;
 pub mod raster;

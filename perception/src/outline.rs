@@ -204,12 +204,43 @@ impl Fits {
 /// `pts` from [`returns`], seen from `lidar`); `None` with fewer than [`MIN_POINTS`] returns
 /// there, or no circle through them.
 pub fn fits(centre: Point2, lidar: &Pose2, pts: &[Option<Point2>; BINS]) -> Option<Fits> {
+    fits_run(&run_near(centre, lidar, pts)?)
+}
+
+/// The run of returns [`fits`] fits (LiDAR frame, in bearing order); `None` with fewer than
+/// [`MIN_POINTS`] returns in it.
+pub fn run_near(
+    centre: Point2,
+    lidar: &Pose2,
+    pts: &[Option<Point2>; BINS],
+) -> Option<Vec<Point2, MAX_NEAR>> {
     let (c, _, spacing) = seen_from(centre, lidar)?;
     let (best, _, _) = near_run(c, pts, NEAR_M, (3.0 * spacing).max(0.06), false);
-    if best.len() < MIN_POINTS {
+    (best.len() >= MIN_POINTS).then_some(best)
+}
+
+/// The run of returns within `near_m` of `centre` that [`crate::outline_average`] averages
+/// (LiDAR frame, in bearing order), linked as [`box_wide`] links them (neighbours within the
+/// range noise, a lone stray skipped); `None` with fewer than 3.
+pub fn run_to_average(
+    centre: Point2,
+    lidar: &Pose2,
+    pts: &[Option<Point2>; BINS],
+    near_m: f32,
+) -> Option<Vec<Point2, MAX_NEAR>> {
+    let (c, range, spacing) = seen_from(centre, lidar)?;
+    let link = (3.0 * spacing).max(0.06 + 0.05 * range);
+    let (run, _, _) = near_run(c, pts, near_m, link, true);
+    (run.len() >= 3).then_some(run)
+}
+
+/// The four fits of `pts`: an outline's points in bearing order as seen from the origin (one
+/// revolution's run, or [`crate::outline_average`]'s averaged outline); `None` with fewer than
+/// [`MIN_POINTS`] or no circle through them.
+pub fn fits_run(pts: &[Point2]) -> Option<Fits> {
+    if pts.len() < MIN_POINTS {
         return None;
     }
-    let pts = &best[..];
     let line = line_sse(pts);
     let n = pts.len() as f32;
     // Two lines split at the point farthest from the chord.
@@ -244,6 +275,18 @@ pub fn fits(centre: Point2, lidar: &Pose2, pts: &[Option<Point2>; BINS]) -> Opti
         corner,
         line,
     })
+}
+
+/// The right-angled corner's sum of squared distances ([`Fits::corner`]) at its best split of
+/// `pts` (each point in turn, both parts of at least two): where the returns are averaged
+/// ([`crate::outline_average`]) the corner is where the fit says, not the point farthest from
+/// the chord that one noisy revolution picks.
+pub fn best_corner(pts: &[Point2]) -> f32 {
+    let mut best = line_sse(pts);
+    for k in 1..pts.len().saturating_sub(1) {
+        best = best.min(right_angle_sse(&pts[..=k], &pts[k..]));
+    }
+    best
 }
 
 /// The scatter matrix of `pts` about their mean: (Σdx², Σdx·dy, Σdy²).

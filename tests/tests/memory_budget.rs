@@ -139,6 +139,11 @@ fn buffers_in_code() -> Vec<(&'static str, usize, usize)> {
             size_of::<perception::tracks::Track>(),
         ),
         (
+            "perception::tracks::OUTLINE_SLOTS",
+            perception::tracks::OUTLINE_SLOTS,
+            size_of::<(u32, perception::outline_average::AveragedOutline)>(),
+        ),
+        (
             "size_of::<perception::calibration::Calibration>()",
             1,
             size_of::<perception::calibration::Calibration>(),

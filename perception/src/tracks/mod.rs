@@ -51,8 +51,10 @@ use crate::free_floor::FreeFloor;
 use crate::fusion::{Evidence, FrameObject};
 use crate::geometry::{Point2, Pose2};
 use crate::motion::{Motion, MotionConfig};
+use crate::outline_average::AveragedOutline;
 use crate::sight::BINS;
 use association::{cheapest, class_cost};
+pub use outline_marks::{AVERAGED_ROUND_MAJORITY, AVERAGED_ROUND_VIEWS, OUTLINE_SLOTS};
 
 mod association;
 mod door_marks;
@@ -224,6 +226,9 @@ pub struct Track {
     /// Over the arc views: the circle's, a right-angled corner's and one line's sums of
     /// squared distances per degree of freedom, summed (m²).
     pub arc_fits: [f32; 3],
+    /// Revolutions in which its outline averaged over revolutions was round, and was not,
+    /// while it was a still box ([`crate::outline_average`], [`Tracks::measure_outlines`]).
+    pub averaged_round: [u16; 2],
     /// A door frame at a corner of the map's walls ([`Tracks::mark_corner_doors`]).
     pub at_corner: bool,
     /// A door frame in the line of one of the map's walls ([`Tracks::mark_corner_doors`]).
@@ -322,6 +327,8 @@ pub struct Tracks {
     stats: TrackStats,
     walkers: Walkers,
     floor: FreeFloor,
+    /// Still box tracks' outlines averaged over revolutions, by id ([`OUTLINE_SLOTS`]).
+    outlines: Vec<(u32, AveragedOutline), OUTLINE_SLOTS>,
 }
 
 impl Default for Tracks {
@@ -345,6 +352,7 @@ impl Tracks {
                 merged: 0,
             },
             walkers: Walkers::new(),
+            outlines: Vec::new(),
             floor: FreeFloor::new(),
         }
     }
@@ -495,6 +503,7 @@ impl Tracks {
                 arc_views: 0,
                 flat_views: 0,
                 arc_fits: [0.0; 3],
+                averaged_round: [0; 2],
                 at_corner: false,
                 in_wall_line: false,
                 p_sum: 0.0,
@@ -821,6 +830,51 @@ mod test {
             t.measure_outlines(&Pose2::IDENTITY, &crate::sight::returns(&r));
         }
         assert!(!t.all()[0].looks_round() && t.all()[0].arc_views == 0);
+    }
+
+    /// A box track at `c` measured over `revs` revolutions of a LiDAR at the origin turning
+    /// 0.03 rad a revolution, with the pillar or box of `crate::outline::test::scan` (map frame)
+    /// and range noise `frac`.
+    fn measured_turning(
+        round: Option<(Point2, f32)>,
+        square: Option<(Point2, f32, f32, f32)>,
+        frac: f32,
+        revs: u32,
+    ) -> Track {
+        use crate::outline::test::{noisy, scan};
+        let c = round.map(|r| r.0).or(square.map(|s| s.0)).unwrap();
+        let mut t = Tracks::new();
+        let seen = obs(ObjectClass::Box, c.x, c.y, 0.9, Evidence::B);
+        step(&mut t, 0, &[seen], &Pose2::IDENTITY, &ranges(0.0), &quick());
+        for k in 0..revs {
+            let lidar = Pose2::new(0.0, 0.0, -0.03 * k as f32);
+            let inv = lidar.inverse();
+            let r = scan(
+                round.map(|(p, rad)| (inv.transform(p), rad)),
+                square.map(|(p, w, h, yaw)| (inv.transform(p), w, h, yaw - lidar.theta)),
+            );
+            let pts = crate::sight::returns(&noisy(r, frac, 11 + k * 7919));
+            t.measure_outlines(&lidar, &pts);
+        }
+        t.all()[0]
+    }
+
+    #[test]
+    fn a_pillar_at_the_simulators_noise_looks_round_once_its_outline_is_averaged() {
+        // A pillar of 0.2 m at 2 m, at 2.5 % range noise: the fits summed over revolutions
+        // say nothing, the averaged outline does.
+        let c = Point2::new(2.0, 0.2);
+        let p = measured_turning(Some((c, 0.2)), None, 0.025, 80);
+        assert!(p.looks_round(), "{p:?}");
+        assert!(p.averaged_round[0] >= AVERAGED_ROUND_VIEWS, "{p:?}");
+        let mut summed_only = p;
+        summed_only.averaged_round = [0; 2];
+        assert!(!summed_only.looks_round(), "the summed fits alone: {p:?}");
+        // A box of 0.6 × 0.4 there is not.
+        for yaw in [0.0f32, 0.5, 1.0] {
+            let b = measured_turning(None, Some((c, 0.6, 0.4, yaw)), 0.025, 80);
+            assert!(!b.looks_round(), "yaw {yaw}: {b:?}");
+        }
     }
 
     #[test]

@@ -2,13 +2,25 @@
 //! seen as wide as any box is a post or a bin ([`Track::too_narrow`]); one whose returns lie
 //! on an arc is a bin or a round pillar ([`Track::looks_round`]). Neither is reported while so.
 //! The views are counted by [`Tracks::measure_outlines`] (`crate::outline` measures one
-//! revolution).
+//! revolution; `crate::outline_average` averages a still box's outline over revolutions, in
+//! [`OUTLINE_SLOTS`] slots).
 
 use crate::class::ObjectClass;
 use crate::geometry::{Point2, Pose2};
+use crate::outline_average::{AveragedOutline, TAKE_M};
 use crate::sight::BINS;
 
 use super::{Track, Tracks};
+
+/// Box tracks whose outlines are averaged over revolutions at once
+/// ([`crate::outline_average`]): a room holds a few boxes and pillars in view.
+pub const OUTLINE_SLOTS: usize = 16;
+/// Revolutions whose averaged outline was round before a "box" is not reported
+/// ([`Track::looks_round`]) ...
+pub const AVERAGED_ROUND_VIEWS: u16 = 8;
+/// ... when they are at least this many times those in which it was not: one that turns round
+/// now and then, where a box's corner is near the noise, is not.
+pub const AVERAGED_ROUND_MAJORITY: u16 = 3;
 
 /// Narrow views before a "box" never seen box-wide is not reported ([`Track::too_narrow`]).
 pub const NARROW_VIEWS: u16 = 3;
@@ -38,46 +50,74 @@ impl Track {
     /// A "box" whose returns lie on an arc: in [`ROUND_VIEWS`] revolutions and more than not
     /// they could, and over those revolutions together a circle fits them better than a
     /// right-angled corner ([`ROUND_CORNER_RATIO`]) and than one line
-    /// ([`ROUND_LINE_RATIO`]). A bin or a round pillar; not reported while so. One
-    /// revolution's few returns cannot tell a pillar's arc from a box's corner under the range
-    /// noise; summed over revolutions the noise averages out, and where it swamps the curve
-    /// the sums read alike and the rule does not fire.
+    /// ([`ROUND_LINE_RATIO`]); or its outline averaged over revolutions was round in
+    /// [`AVERAGED_ROUND_VIEWS`] revolutions and [`AVERAGED_ROUND_MAJORITY`] times as many as
+    /// not. A bin or a round pillar; not reported while so. One revolution's few returns
+    /// cannot tell a pillar's arc from a box's corner under the range noise, and the summed
+    /// fits only where the noise is small (each revolution's fits follow its own noise);
+    /// averaging the returns themselves takes the noise out of the shape.
     pub fn looks_round(&self) -> bool {
         let [circle, corner, line] = self.arc_fits;
-        self.class() == ObjectClass::Box
-            && self.arc_views >= ROUND_VIEWS
+        let [yes, no] = self.averaged_round;
+        let summed = self.arc_views >= ROUND_VIEWS
             && self.arc_views > self.flat_views
             && circle <= ROUND_CORNER_RATIO * corner
-            && circle <= ROUND_LINE_RATIO * line
+            && circle <= ROUND_LINE_RATIO * line;
+        let averaged = yes >= AVERAGED_ROUND_VIEWS
+            && u32::from(yes) >= u32::from(AVERAGED_ROUND_MAJORITY) * u32::from(no);
+        self.class() == ObjectClass::Box && (summed || averaged)
     }
 }
 
 impl Tracks {
     /// Box tracks that stand still: whether their returns in this revolution look as wide as
-    /// a box ([`crate::outline::box_wide`]) and how they fit an arc
-    /// ([`crate::outline::fits`]); `pts` from [`crate::sight::returns`], `lidar` the
-    /// LiDAR's pose in the map. Counted into [`Track::too_narrow`]'s and
-    /// [`Track::looks_round`]'s views.
+    /// a box ([`crate::outline::box_wide`]), how they fit an arc ([`crate::outline::fits`])
+    /// and whether their outline averaged over revolutions is round
+    /// ([`crate::outline_average`]); `pts` from [`crate::sight::returns`], `lidar` the LiDAR's
+    /// pose in the map. Counted into [`Track::too_narrow`]'s and [`Track::looks_round`]'s
+    /// views.
     pub fn measure_outlines(&mut self, lidar: &Pose2, pts: &[Option<Point2>; BINS]) {
+        let still_box = |t: &Track| t.class() == ObjectClass::Box && !t.motion.moving;
+        // Slots of tracks gone, moving or no longer boxes are free again.
+        let tracks = &self.tracks;
+        self.outlines
+            .retain(|(id, _)| tracks.iter().any(|t| t.id == *id && still_box(t)));
         for t in self.tracks.iter_mut() {
-            if t.class() == ObjectClass::Box && !t.motion.moving {
-                match crate::outline::box_wide(t.centre, lidar, pts) {
-                    Some(true) => t.box_wide_views = t.box_wide_views.saturating_add(1),
-                    Some(false) => t.narrow_views = t.narrow_views.saturating_add(1),
-                    None => {}
-                }
-                match crate::outline::fits(t.centre, lidar, pts) {
-                    Some(f) if f.arc => {
-                        t.arc_views = t.arc_views.saturating_add(1);
-                        for (sum, v) in t.arc_fits.iter_mut().zip(f.variances()) {
-                            if v.is_finite() {
-                                *sum += v;
-                            }
+            if !still_box(t) {
+                continue;
+            }
+            match crate::outline::box_wide(t.centre, lidar, pts) {
+                Some(true) => t.box_wide_views = t.box_wide_views.saturating_add(1),
+                Some(false) => t.narrow_views = t.narrow_views.saturating_add(1),
+                None => {}
+            }
+            match crate::outline::fits(t.centre, lidar, pts) {
+                Some(f) if f.arc => {
+                    t.arc_views = t.arc_views.saturating_add(1);
+                    for (sum, v) in t.arc_fits.iter_mut().zip(f.variances()) {
+                        if v.is_finite() {
+                            *sum += v;
                         }
                     }
-                    Some(_) => t.flat_views = t.flat_views.saturating_add(1),
-                    None => {}
                 }
+                Some(_) => t.flat_views = t.flat_views.saturating_add(1),
+                None => {}
+            }
+            let Some(run) = crate::outline::run_to_average(t.centre, lidar, pts, TAKE_M) else {
+                continue;
+            };
+            let slot = match self.outlines.iter().position(|(id, _)| *id == t.id) {
+                Some(k) => k,
+                None if self.outlines.push((t.id, AveragedOutline::EMPTY)).is_ok() => {
+                    self.outlines.len() - 1
+                }
+                None => continue, // every slot taken: this one waits
+            };
+            let avg = &mut self.outlines[slot].1;
+            avg.add(t.centre, lidar, &run);
+            if let Some(round) = avg.round() {
+                let k = usize::from(!round);
+                t.averaged_round[k] = t.averaged_round[k].saturating_add(1);
             }
         }
     }
