@@ -25,6 +25,7 @@
 //! | [`map_doors`]  | doorways in the map's walls that this revolution's rays pass through |
 //! | [`wall_piece`] | a detection whose returns lie on a line that goes on as a wall does |
 //! | [`outline`]    | a "box" whose returns lie on an arc (a bin, a round pillar) |
+//! | [`outline_average`] | a still object's outline averaged over revolutions, fitted as one |
 //! | [`fusion`]     | one frame's objects from both methods: A's, and B's joined or added |
 //! | [`calibration`] | what a detection's score means: a measured probability per source and class |
 //! | [`sight`]      | what a revolution showed of a footprint (hidden, in view, seen empty) or a doorway |
