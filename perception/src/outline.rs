@@ -104,6 +104,13 @@ fn near_run(
     best
 }
 
+/// Two returns at `range` (bins `spacing` apart there) lie on one surface within this, m: three
+/// bins' spacing, or the range noise (2.5 % of range in the simulator) between two returns,
+/// whichever is more.
+fn noise_link(range: f32, spacing: f32) -> f32 {
+    (3.0 * spacing).max(0.06 + 0.05 * range)
+}
+
 /// `centre` (map frame) in the LiDAR's frame, its range and the spacing of two bins there, m;
 /// None when not a number or on the LiDAR itself.
 fn seen_from(centre: Point2, lidar: &Pose2) -> Option<(Point2, f32, f32)> {
@@ -127,9 +134,7 @@ fn seen_from(centre: Point2, lidar: &Pose2) -> Option<(Point2, f32, f32)> {
 /// thing's is its diameter. Something in front can only narrow it.
 pub fn box_wide(centre: Point2, lidar: &Pose2, pts: &[Option<Point2>; BINS]) -> Option<bool> {
     let (c, range, spacing) = seen_from(centre, lidar)?;
-    // Neighbours on one surface: three bins' spacing, or the range noise (2.5 % of range in
-    // the simulator) between two returns, whichever is more.
-    let link = (3.0 * spacing).max(0.06 + 0.05 * range);
+    let link = noise_link(range, spacing);
     let (run, first, last) = near_run(c, pts, WIDTH_NEAR_M + 0.05 * range, link, true);
     if run.len() < 3 {
         return None;
@@ -229,8 +234,7 @@ pub fn run_to_average(
     near_m: f32,
 ) -> Option<Vec<Point2, MAX_NEAR>> {
     let (c, range, spacing) = seen_from(centre, lidar)?;
-    let link = (3.0 * spacing).max(0.06 + 0.05 * range);
-    let (run, _, _) = near_run(c, pts, near_m, link, true);
+    let (run, _, _) = near_run(c, pts, near_m, noise_link(range, spacing), true);
     (run.len() >= 3).then_some(run)
 }
 
@@ -442,6 +446,19 @@ pub(crate) mod test {
             *slot = best;
         }
         r
+    }
+
+    /// [`scan`]'s pillar or box, placed in the map, as a LiDAR at `lidar` (map frame) sees it.
+    pub(crate) fn scan_from(
+        lidar: &Pose2,
+        round: Option<(Point2, f32)>,
+        square: Option<(Point2, f32, f32, f32)>,
+    ) -> [f32; BINS] {
+        let inv = lidar.inverse();
+        scan(
+            round.map(|(c, rad)| (inv.transform(c), rad)),
+            square.map(|(c, w, h, yaw)| (inv.transform(c), w, h, yaw - lidar.theta)),
+        )
     }
 
     /// `r` with range noise σ = 5 mm + `frac` of the range (the annex's model at 0.006).

@@ -175,42 +175,36 @@ impl AveragedOutline {
 mod test {
     use super::*;
     use crate::outline::run_to_average;
-    use crate::outline::test::{noisy, scan};
+    use crate::outline::test::{noisy, scan_from};
     use crate::sight::returns;
-    use crate::tracks::{AVERAGED_ROUND_MAJORITY, AVERAGED_ROUND_VIEWS};
+    use crate::tracks::averaged_vote;
 
     /// A pillar (`round`: centre, radius) or a box (`square`: centre, w, h, yaw) in the map,
-    /// seen from a LiDAR at the origin that turns by `turn` rad a revolution, for `revs`
-    /// revolutions at range noise `frac` of the range: whether a track's vote on the averaged
-    /// outline ([`crate::tracks::Track::looks_round`]) ever calls it round.
+    /// seen for `revs` revolutions from a LiDAR at `lidar_at(k)` in revolution `k`, at range
+    /// noise `frac` of the range: whether a track's vote on the averaged outline
+    /// ([`averaged_vote`], as [`crate::tracks::Track::looks_round`] keeps it) ever calls it
+    /// round.
     fn ever_round(
         round: Option<(Point2, f32)>,
         square: Option<(Point2, f32, f32, f32)>,
         frac: f32,
         revs: u32,
-        turn: f32,
+        lidar_at: impl Fn(f32) -> Pose2,
     ) -> bool {
         let centre = round.map(|r| r.0).or(square.map(|s| s.0)).unwrap();
         let mut avg = AveragedOutline::EMPTY;
-        let (mut yes, mut no) = (0u16, 0u16);
+        let mut votes = [0u16; 2];
         for k in 0..revs {
-            let lidar = Pose2::new(0.0, 0.0, turn * k as f32);
-            let inv = lidar.inverse();
-            // The scene in the LiDAR's frame.
-            let r = scan(
-                round.map(|(c, rad)| (inv.transform(c), rad)),
-                square.map(|(c, w, h, yaw)| (inv.transform(c), w, h, yaw - lidar.theta)),
-            );
+            let lidar = lidar_at(k as f32);
+            let r = scan_from(&lidar, round, square);
             let pts = returns(&noisy(r, frac, 7 + k * 7919));
             if let Some(run) = run_to_average(centre, &lidar, &pts, TAKE_M) {
                 avg.add(centre, &lidar, &run);
             }
-            match avg.round() {
-                Some(true) => yes += 1,
-                Some(false) => no += 1,
-                None => {}
+            if let Some(round) = avg.round() {
+                votes[usize::from(!round)] += 1;
             }
-            if yes >= AVERAGED_ROUND_VIEWS && yes >= AVERAGED_ROUND_MAJORITY * no {
+            if averaged_vote(votes) {
                 return true;
             }
         }
@@ -227,12 +221,13 @@ mod test {
         let mut found = [0u32; 2];
         let mut cases = [0u32; 2];
         for (ti, turn) in [0.0f32, -0.03].into_iter().enumerate() {
+            let at = |k: f32| Pose2::new(0.0, 0.0, turn * k);
             for frac in [0.015f32, 0.025, 0.035] {
                 for range in [1.0f32, 1.7, 2.5] {
                     for rad in [0.15f32, 0.2, 0.25] {
                         let c = Point2::new(range, 0.2);
                         cases[ti] += 1;
-                        found[ti] += u32::from(ever_round(Some((c, rad)), None, frac, 80, turn));
+                        found[ti] += u32::from(ever_round(Some((c, rad)), None, frac, 80, at));
                     }
                 }
                 for range in [1.0f32, 2.0, 3.0, 3.3] {
@@ -241,7 +236,7 @@ mod test {
                             let yaw = k as f32 * 0.4;
                             let c = Point2::new(range + 0.1, 0.1 - 0.1 * k as f32);
                             assert!(
-                                !ever_round(None, Some((c, w, h, yaw)), frac, 80, turn),
+                                !ever_round(None, Some((c, w, h, yaw)), frac, 80, at),
                                 "box {w}x{h} yaw {yaw} at {range} m, noise {frac}, turn {turn}"
                             );
                         }
@@ -252,40 +247,6 @@ mod test {
         // When written: 23 of 27 from a LiDAR that does not turn, 25 of 27 from one that does.
         assert!(found[0] >= 20, "{found:?} of {cases:?}");
         assert!(found[1] >= 22, "{found:?} of {cases:?}");
-    }
-
-    /// [`ever_round`] from a LiDAR that moves by `step` and turns 0.013 rad a revolution.
-    fn ever_round_moving(
-        round: Option<(Point2, f32)>,
-        square: Option<(Point2, f32, f32, f32)>,
-        frac: f32,
-        revs: u32,
-        step: Point2,
-    ) -> bool {
-        let centre = round.map(|r| r.0).or(square.map(|s| s.0)).unwrap();
-        let mut avg = AveragedOutline::EMPTY;
-        let (mut yes, mut no) = (0u16, 0u16);
-        for k in 0..revs {
-            let lidar = Pose2::new(step.x * k as f32, step.y * k as f32, 0.013 * k as f32);
-            let inv = lidar.inverse();
-            let r = scan(
-                round.map(|(c, rad)| (inv.transform(c), rad)),
-                square.map(|(c, w, h, yaw)| (inv.transform(c), w, h, yaw - lidar.theta)),
-            );
-            let pts = returns(&noisy(r, frac, 7 + k * 7919));
-            if let Some(run) = run_to_average(centre, &lidar, &pts, TAKE_M) {
-                avg.add(centre, &lidar, &run);
-            }
-            match avg.round() {
-                Some(true) => yes += 1,
-                Some(false) => no += 1,
-                None => {}
-            }
-            if yes >= AVERAGED_ROUND_VIEWS && yes >= AVERAGED_ROUND_MAJORITY * no {
-                return true;
-            }
-        }
-        false
     }
 
     /// A LiDAR driving 0.03 m a revolution (a tour's 0.15 m/s at 5 Hz) past, towards and
@@ -299,19 +260,21 @@ mod test {
             Point2::new(0.03, 0.0),
             Point2::new(0.02, -0.02),
         ] {
+            // Turning 0.013 rad a revolution as it drives.
+            let at = |k: f32| Pose2::new(step.x * k, step.y * k, 0.013 * k);
             for frac in [0.015f32, 0.025, 0.035] {
                 for range in [1.5f32, 2.5, 3.0] {
                     for rad in [0.15f32, 0.2, 0.25] {
                         let c = Point2::new(range, 0.2);
                         cases += 1;
-                        found += u32::from(ever_round_moving(Some((c, rad)), None, frac, 60, step));
+                        found += u32::from(ever_round(Some((c, rad)), None, frac, 60, at));
                     }
                     for (w, h) in [(0.6f32, 0.4f32), (0.48, 0.32), (0.8, 0.3), (0.35, 0.35)] {
                         for k in 0..4 {
                             let yaw = k as f32 * 0.4;
                             let c = Point2::new(range + 0.1, 0.1 - 0.1 * k as f32);
                             assert!(
-                                !ever_round_moving(None, Some((c, w, h, yaw)), frac, 60, step),
+                                !ever_round(None, Some((c, w, h, yaw)), frac, 60, at),
                                 "box {w}x{h} yaw {yaw} at {range} m, noise {frac}, step {step:?}"
                             );
                         }

@@ -54,7 +54,9 @@ use crate::motion::{Motion, MotionConfig};
 use crate::outline_average::AveragedOutline;
 use crate::sight::BINS;
 use association::{cheapest, class_cost};
-pub use outline_marks::{AVERAGED_ROUND_MAJORITY, AVERAGED_ROUND_VIEWS, OUTLINE_SLOTS};
+pub use outline_marks::{
+    AVERAGED_ROUND_MAJORITY, AVERAGED_ROUND_VIEWS, OUTLINE_SLOTS, averaged_vote,
+};
 
 mod association;
 mod door_marks;
@@ -841,18 +843,14 @@ mod test {
         frac: f32,
         revs: u32,
     ) -> Track {
-        use crate::outline::test::{noisy, scan};
+        use crate::outline::test::{noisy, scan_from};
         let c = round.map(|r| r.0).or(square.map(|s| s.0)).unwrap();
         let mut t = Tracks::new();
         let seen = obs(ObjectClass::Box, c.x, c.y, 0.9, Evidence::B);
         step(&mut t, 0, &[seen], &Pose2::IDENTITY, &ranges(0.0), &quick());
         for k in 0..revs {
             let lidar = Pose2::new(0.0, 0.0, -0.03 * k as f32);
-            let inv = lidar.inverse();
-            let r = scan(
-                round.map(|(p, rad)| (inv.transform(p), rad)),
-                square.map(|(p, w, h, yaw)| (inv.transform(p), w, h, yaw - lidar.theta)),
-            );
+            let r = scan_from(&lidar, round, square);
             let pts = crate::sight::returns(&noisy(r, frac, 11 + k * 7919));
             t.measure_outlines(&lidar, &pts);
         }

@@ -58,15 +58,20 @@ impl Track {
     /// averaging the returns themselves takes the noise out of the shape.
     pub fn looks_round(&self) -> bool {
         let [circle, corner, line] = self.arc_fits;
-        let [yes, no] = self.averaged_round;
         let summed = self.arc_views >= ROUND_VIEWS
             && self.arc_views > self.flat_views
             && circle <= ROUND_CORNER_RATIO * corner
             && circle <= ROUND_LINE_RATIO * line;
-        let averaged = yes >= AVERAGED_ROUND_VIEWS
-            && u32::from(yes) >= u32::from(AVERAGED_ROUND_MAJORITY) * u32::from(no);
-        self.class() == ObjectClass::Box && (summed || averaged)
+        self.class() == ObjectClass::Box && (summed || averaged_vote(self.averaged_round))
     }
+}
+
+/// The vote on the averaged outline ([`Track::averaged_round`]: revolutions round, not
+/// round): round in [`AVERAGED_ROUND_VIEWS`] and [`AVERAGED_ROUND_MAJORITY`] times as many as
+/// not.
+pub fn averaged_vote([yes, no]: [u16; 2]) -> bool {
+    yes >= AVERAGED_ROUND_VIEWS
+        && u32::from(yes) >= u32::from(AVERAGED_ROUND_MAJORITY) * u32::from(no)
 }
 
 impl Tracks {
