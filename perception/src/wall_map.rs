@@ -55,6 +55,10 @@ pub const DOOR_LINE_M: f32 = 0.2;
 /// … and no farther beyond the line's end than half the widest doorway (0.7 m) and a jamb's
 /// allowance, m.
 pub const DOOR_REACH_M: f32 = 0.9;
+/// Narrowest doorway [`WallMap::far_jamb`] assumes, m.
+pub const MIN_DOOR_M: f32 = 0.75;
+/// Widest doorway [`WallMap::far_jamb`] assumes, m.
+pub const MAX_DOOR_M: f32 = 1.3;
 /// Weight at most of a line's past when a segment joins it (so a line can still settle).
 const MAX_WEIGHT: f32 = 20.0;
 /// Side votes are kept within ±this.
@@ -401,6 +405,32 @@ impl WallMap {
         })
     }
 
+    /// Where a doorway's other jamb would stand if `p` were the middle of a doorway beside the
+    /// end of a confirmed line: `p` in that line ([`DOOR_LINE_M`]) and past the end by at most
+    /// [`DOOR_REACH_M`]; the end is one jamb, and the other stands as far again past `p`, a
+    /// doorway's width ([`MIN_DOOR_M`]–[`MAX_DOOR_M`]) from the end, in the line. `None` when
+    /// `p` stands past no line's end.
+    pub fn far_jamb(&self, p: Point2) -> Option<Point2> {
+        if !(p.x.is_finite() && p.y.is_finite()) {
+            return None;
+        }
+        self.walls.iter().filter(|w| w.confirmed()).find_map(|w| {
+            if libm::fabsf(w.in_front(p)) > DOOR_LINE_M {
+                return None;
+            }
+            let u = w.along(p);
+            let (past, end, out) = if u > w.hi {
+                (u - w.hi, w.hi, 1.0)
+            } else if u < w.lo {
+                (w.lo - u, w.lo, -1.0)
+            } else {
+                return None;
+            };
+            (past <= DOOR_REACH_M)
+                .then(|| w.at(end + out * (2.0 * past).clamp(MIN_DOOR_M, MAX_DOOR_M)))
+        })
+    }
+
     /// Whether `p` lies in a confirmed wall's band: less than [`IN_WALL_M`] in front of its
     /// face or up to [`BEHIND_M`] behind it, within its extent — unless `p` is well in front
     /// of another confirmed line facing the other way there (the far side of a thin wall
@@ -483,6 +513,26 @@ mod test {
         // The longer line spans both pieces.
         let long = map.walls().iter().map(MapWall::length).fold(0.0, f32::max);
         assert!((long - 3.0).abs() < 0.05, "{long}");
+    }
+
+    #[test]
+    fn a_doorways_other_jamb_stands_a_door_width_past_a_walls_end() {
+        let mut map = WallMap::new();
+        seen(&mut map, &[seg(-3.0, 2.0, 0.0, 2.0)], 3);
+        let near = |p: Option<Point2>, x: f32, y: f32| {
+            p.is_some_and(|p| p.distance(Point2::new(x, y)) < 0.03)
+        };
+        // A middle 0.45 m past the end: a 0.9 m doorway, its other jamb at x = 0.9.
+        assert!(near(map.far_jamb(Point2::new(0.45, 2.05)), 0.9, 2.0));
+        // Closer to the end: the narrowest doorway; at the reach's end: the widest.
+        assert!(near(map.far_jamb(Point2::new(0.1, 2.0)), 0.75, 2.0));
+        assert!(near(map.far_jamb(Point2::new(0.85, 2.0)), 1.3, 2.0));
+        // Past the other end: the jamb lies that way.
+        assert!(near(map.far_jamb(Point2::new(-3.4, 1.95)), -3.8, 2.0));
+        // In the wall's extent, off its line, too far past its end, or not a number: none.
+        for p in [(-1.0, 2.0), (0.45, 1.6), (1.0, 2.0), (f32::NAN, 2.0)] {
+            assert_eq!(map.far_jamb(Point2::new(p.0, p.1)), None, "{p:?}");
+        }
     }
 
     #[test]

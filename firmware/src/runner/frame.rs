@@ -414,6 +414,13 @@ impl<S: RevolutionStream> FrameLoop<'_, S> {
             st.tracks.anchor_doors(&doorways);
             // Nor is Method B's door frame at a corner of them.
             st.tracks.mark_corner_doors(&st.wall_map);
+            // Nor is one beside a wall's end whose other jamb's place the rays show empty.
+            st.tracks.look_for_far_jambs(
+                &st.wall_map,
+                &lidar,
+                st.history.newest(),
+                cfg.max_range_m,
+            );
             // How wide the boxes look and whether they are round: a bin or a post is narrower
             // than any box, and a pillar's returns lie on an arc.
             st.tracks.measure_outlines(&lidar, &returns);

@@ -1,20 +1,38 @@
 //! What the map's walls say of door-frame tracks: one in a doorway they show is an opening in
 //! a wall (anchored), as is one seen often in the line of one of them (held); one at a corner
 //! of them that only Method B has seen is the end of a wall seen end-on (not reported while
-//! so).
+//! so), as is one beside a wall's end whose other jamb's place the rays show empty.
 
 use crate::class::ObjectClass;
-use crate::geometry::Point2;
+use crate::geometry::{Point2, Pose2};
+use crate::sight::{BINS, View, view};
 use crate::wall_map::WallMap;
 
 use super::{CORNER_DOOR_M, Track, TrackConfig, Tracks, class_radius};
+
+/// Radius of a jamb's place looked at, m (a wall's end: 0.05–0.25 m thick).
+pub const JAMB_M: f32 = 0.15;
+/// Revolutions that must show a door frame's other jamb's place empty before it counts as a
+/// wall's end ([`Track::lone_jamb`]).
+pub const LONE_JAMB_VIEWS: u16 = 3;
 
 impl Track {
     /// A door frame only Method B has seen, not in a doorway of the map's walls, at a corner
     /// of them: the end of a wall seen end-on looks like a jamb to Method B (an L-shaped
     /// room's inner corner). Not reported while so.
     pub fn door_at_corner(&self) -> bool {
-        self.class() == ObjectClass::DoorFrame && self.at_corner && !self.seen_a && !self.anchored
+        self.class() == ObjectClass::DoorFrame
+            && (self.at_corner || self.lone_jamb())
+            && !self.seen_a
+            && !self.anchored
+    }
+
+    /// Beside a wall's end, the place of the doorway's other jamb was seen empty in
+    /// [`LONE_JAMB_VIEWS`] revolutions and more often than not: a wall that ends (a partition,
+    /// an L-shaped room's corner seen end-on) with floor beyond it, not a doorway.
+    pub fn lone_jamb(&self) -> bool {
+        let [empty, there] = self.far_jamb_views;
+        empty >= LONE_JAMB_VIEWS && empty > there
     }
 
     /// A door frame judged as a doorway by what the rays show of it: the map's walls showed it
@@ -38,6 +56,36 @@ impl Tracks {
                     .any(|d| d.distance(t.centre) <= class_radius(ObjectClass::DoorFrame))
             {
                 t.anchored = true;
+            }
+        }
+    }
+
+    /// For each door-frame track beside the end of a confirmed line of the map
+    /// ([`WallMap::far_jamb`]), what this revolution (`ranges`, from `lidar`) shows of the place
+    /// of its other jamb: seen empty, or returning (hidden or out of reach: nothing). See
+    /// [`Track::lone_jamb`]; one reported is reported no more.
+    pub fn look_for_far_jambs(
+        &mut self,
+        walls: &WallMap,
+        lidar: &Pose2,
+        ranges: &[f32; BINS],
+        max_range_m: f32,
+    ) {
+        for t in self.tracks.iter_mut() {
+            if t.class() != ObjectClass::DoorFrame || t.anchored {
+                continue;
+            }
+            let Some(jamb) = walls.far_jamb(t.centre) else {
+                continue;
+            };
+            let k = match view(jamb, JAMB_M, lidar, ranges, max_range_m) {
+                View::Empty => 0,
+                View::Plain(_) => 1,
+                View::Hidden => continue,
+            };
+            t.far_jamb_views[k] = t.far_jamb_views[k].saturating_add(1);
+            if t.door_at_corner() {
+                t.confirmed = false;
             }
         }
     }

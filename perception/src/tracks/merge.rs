@@ -67,6 +67,9 @@ impl Tracks {
                 t.anchored |= gone.anchored;
                 t.box_wide_views = t.box_wide_views.saturating_add(gone.box_wide_views);
                 t.narrow_views = t.narrow_views.saturating_add(gone.narrow_views);
+                for (v, x) in t.far_jamb_views.iter_mut().zip(gone.far_jamb_views) {
+                    *v = v.saturating_add(x);
+                }
                 self.tracks.swap_remove(g);
                 self.stats.merged += 1;
                 if g == i {

@@ -66,6 +66,7 @@ mod negative;
 mod outline_marks;
 mod walkers;
 
+pub use door_marks::{JAMB_M, LONE_JAMB_VIEWS};
 pub use negative::Looked;
 pub use outline_marks::{NARROW_VIEWS, ROUND_CORNER_RATIO, ROUND_LINE_RATIO, ROUND_VIEWS};
 pub use walkers::{MAX_WALKERS, SAME_PERSON_M, Walker, Walkers};
@@ -235,6 +236,9 @@ pub struct Track {
     pub at_corner: bool,
     /// A door frame in the line of one of the map's walls ([`Tracks::mark_corner_doors`]).
     pub in_wall_line: bool,
+    /// Revolutions that showed the place of its other jamb, beside a wall's end, empty and
+    /// returning ([`Track::lone_jamb`]).
+    pub far_jamb_views: [u16; 2],
     /// Sum of its observations' probabilities ([`TrackConfig::calibration`]); over its hits,
     /// how likely what the methods saw there was right ([`Track::likelihood`]).
     pub p_sum: f32,
@@ -508,6 +512,7 @@ impl Tracks {
                 averaged_round: [0; 2],
                 at_corner: false,
                 in_wall_line: false,
+                far_jamb_views: [0; 2],
                 p_sum: 0.0,
             };
             Self::hit(&mut t, o, frame, stamp_s, cfg);
@@ -1208,6 +1213,50 @@ mod test {
         assert_eq!(t.confirmed().count(), 1);
         t.mark_corner_doors(&walls);
         assert_eq!(t.confirmed().count(), 0);
+    }
+
+    #[test]
+    fn method_b_door_frames_beside_a_walls_end_with_no_other_jamb_are_not_reported() {
+        use crate::walls::test_seg as seg;
+        let cfg = TrackConfig {
+            single_method_hits: 3,
+            ..quick()
+        };
+        // A wall along y = 2 that ends at x = 0 (a partition's end), seen from the origin;
+        // Method B's door frame 0.45 m past its end, where the other jamb would be at x = 0.9.
+        let walls = walls_seen(&[seg(-3.0, 2.0, 0.0, 2.0)]);
+        let bin_of = |x: f32, y: f32| (libm::atan2f(y, x).to_degrees().round() as usize) % BINS;
+        // Open floor beyond the end: the rays past it return from 3.4 m.
+        // The wall y = 2 returns in the bins from `from` to `to`.
+        let wall = |scan: &mut [f32; BINS], from: usize, to: usize| {
+            for (d, r) in scan.iter_mut().enumerate().take(to + 1).skip(from) {
+                *r = 2.0 / libm::sinf((d as f32).to_radians());
+            }
+        };
+        let mut open = ranges(3.4);
+        wall(&mut open, bin_of(0.0, 2.0), bin_of(-3.0, 2.0));
+        // A doorway: the wall goes on from x = 0.9.
+        let mut doorway = open;
+        wall(&mut doorway, bin_of(4.0, 2.0), bin_of(0.9, 2.0));
+        let seen = |scan: &[f32; BINS], evidence: Evidence| {
+            let mut t = Tracks::new();
+            let door = obs(ObjectClass::DoorFrame, 0.45, 2.0, 0.9, evidence);
+            for f in 0..8 {
+                step(&mut t, f, &[door], &Pose2::IDENTITY, scan, &cfg);
+                t.mark_corner_doors(&walls);
+                t.look_for_far_jambs(&walls, &Pose2::IDENTITY, scan, cfg.max_range_m);
+            }
+            t
+        };
+        let t = seen(&open, Evidence::B);
+        assert!(t.all()[0].lone_jamb(), "{:?}", t.all()[0].far_jamb_views);
+        assert_eq!(t.confirmed().count(), 0);
+        // Its other jamb there: a doorway, reported.
+        let t = seen(&doorway, Evidence::B);
+        assert!(!t.all()[0].lone_jamb(), "{:?}", t.all()[0].far_jamb_views);
+        assert_eq!(t.confirmed().count(), 1);
+        // Method A's door frames are judged by Method A's own rules.
+        assert_eq!(seen(&open, Evidence::A).confirmed().count(), 1);
     }
 
     #[test]
