@@ -401,26 +401,14 @@ impl<S: RevolutionStream> FrameLoop<'_, S> {
                 a: method_a_ms.is_some(),
                 b: method_b_ms.is_some(),
             };
-            st.tracks.update(
-                frame,
-                mid_s,
-                &st.fused,
-                &lidar,
-                st.history.newest(),
-                looked,
-                cfg,
-            );
+            let ranges = st.history.newest();
+            st.tracks
+                .update(frame, mid_s, &st.fused, &lidar, ranges, looked, cfg);
             // Door frames in a doorway of the map's walls are openings in a wall.
             st.tracks.anchor_doors(&doorways);
-            // Nor is Method B's door frame at a corner of them.
-            st.tracks.mark_corner_doors(&st.wall_map);
-            // Nor is one beside a wall's end whose other jamb's place the rays show empty.
-            st.tracks.look_for_far_jambs(
-                &st.wall_map,
-                &lidar,
-                st.history.newest(),
-                cfg.max_range_m,
-            );
+            // Nor is Method B's door frame at a corner of them, or at a wall's end with no jamb.
+            st.tracks
+                .mark_wall_doors(&st.wall_map, &lidar, ranges, cfg.max_range_m);
             // How wide the boxes look and whether they are round: a bin or a post is narrower
             // than any box, and a pillar's returns lie on an arc.
             st.tracks.measure_outlines(&lidar, &returns);

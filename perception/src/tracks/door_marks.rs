@@ -60,6 +60,20 @@ impl Tracks {
         }
     }
 
+    /// What the map's walls and this revolution say of the door-frame tracks: at a corner of
+    /// the walls ([`Tracks::mark_corner_doors`]), and beside a wall's end with no other jamb
+    /// ([`Tracks::look_for_far_jambs`]).
+    pub fn mark_wall_doors(
+        &mut self,
+        walls: &WallMap,
+        lidar: &Pose2,
+        ranges: &[f32; BINS],
+        max_range_m: f32,
+    ) {
+        self.mark_corner_doors(walls);
+        self.look_for_far_jambs(walls, lidar, ranges, max_range_m);
+    }
+
     /// For each door-frame track beside the end of a confirmed line of the map
     /// ([`WallMap::far_jamb`]), what this revolution (`ranges`, from `lidar`) shows of the place
     /// of its other jamb: seen empty, or returning (hidden or out of reach: nothing). See
