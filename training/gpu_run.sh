@@ -16,7 +16,9 @@
 # Knobs (environment): SCENARIOS (16000), SEED (35; never an eval or test seed), HOURS (0.11),
 # BATCH (128), LR0 (0.0005), WORKERS (14), DEVICE (0), PY (python3), NAME (gpu19), LIMIT (560:
 # seconds from the start after which training is interrupted, so the weights saved at the last
-# epoch still come back inside the call's 600 s).
+# epoch still come back inside the call's 600 s), INIT (checkpoints/continue.pt, relative to
+# training/), and the data's mix: VARIED (0), ROUND (0), OFFICE (0), PEOPLE (0), CLUTTER (6),
+# the `umbra-sim dataset` options of the same names (`--round-tables`, `--office-chairs`).
 # Run locally on CPU with e.g. `SCENARIOS=40 HOURS=0.005 DEVICE=cpu PY=.venv/bin/python
 # OUT=/tmp/gpu-out bash training/gpu_run.sh` to check it before spending device time.
 set -euo pipefail
@@ -29,6 +31,12 @@ WORKERS=${WORKERS:-14}
 DEVICE=${DEVICE:-0}
 PY=${PY:-python3}
 NAME=${NAME:-gpu19}
+INIT=${INIT:-checkpoints/continue.pt}
+VARIED=${VARIED:-0}
+ROUND=${ROUND:-0}
+OFFICE=${OFFICE:-0}
+PEOPLE=${PEOPLE:-0}
+CLUTTER=${CLUTTER:-6}
 DATA=${DATA:-/tmp/umbra-gpu-data}
 : "${OUT:?OUT must name a folder for the results}"
 mkdir -p "$OUT"
@@ -48,7 +56,9 @@ LIMIT=${LIMIT:-560}
 t0=$(date +%s)
 rm -rf "$DATA"
 .gpu/umbra-sim dataset --out "$DATA" --scenarios "$SCENARIOS" --frames 4 --seed "$SEED" \
-    --kinds rect,tworooms --clutter 6 --no-method-a --no-recordings --pictures 0 >"$OUT/dataset.log"
+    --kinds rect,tworooms --clutter "$CLUTTER" --varied "$VARIED" --round-tables "$ROUND" \
+    --office-chairs "$OFFICE" --people "$PEOPLE" --no-method-a --no-recordings --pictures 0 \
+    >"$OUT/dataset.log"
 echo "dataset: $(ls "$DATA/images/train" | wc -l) train images in $(( $(date +%s) - t0 )) s"
 
 cd training
@@ -57,8 +67,8 @@ set +e
 PYTHONUNBUFFERED=1 timeout --signal=INT --kill-after=15 $(( LIMIT - ($(date +%s) - t0) )) \
     "$PY" train.py --data "$DATA/data.yaml" --device "$DEVICE" --workers "$WORKERS" \
     --batch "$BATCH" --epochs 100 --hours "$HOURS" --name "$NAME" \
-    --init checkpoints/continue.pt --lr0 "$LR0" --seed "$SEED" 2>&1 | tee "$OUT/train.log" | \
-    grep -v "^ *[0-9]*/[0-9]* .*it/s" | tail -n 60
+    --init "$INIT" --lr0 "$LR0" --seed "$SEED" 2>&1 | tee "$OUT/train.log" | \
+    tr '\r' '\n' | grep -a -v "it/s" | tail -n 80
 rc=${PIPESTATUS[0]}
 set -e
 for f in best.pt last.pt; do
