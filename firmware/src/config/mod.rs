@@ -555,8 +555,8 @@ mod test {
         );
         let bad: Config = toml::from_str("[world]\nmin_likelihood = 1.5\n").unwrap();
         assert!(bad.validate().unwrap_err().contains("world.min_likelihood"));
-        // Set, it reaches the track table with the compiled-in calibration; unset, nothing is
-        // held back.
+        // Set, it reaches the track table with the compiled-in calibration; unset, the
+        // default holds back what is right less than half the time.
         let w: Config = toml::from_str("[world]\nmin_likelihood = 0.6\n").unwrap();
         let t = w.world.tracks();
         assert_eq!(t.min_likelihood, 0.6);
@@ -564,7 +564,9 @@ mod test {
             t.calibration,
             perception::calibration::Calibration::IDENTITY
         );
-        assert_eq!(Config::default().world.tracks().min_likelihood, 0.0);
+        assert_eq!(Config::default().world.tracks().min_likelihood, 0.5);
+        let w: Config = toml::from_str("[world]\nmin_likelihood = 0\n").unwrap();
+        assert_eq!(w.world.tracks().min_likelihood, 0.0);
         assert_eq!(Config::default().world.tracks().min_desk_likelihood, 0.6);
         assert_eq!(Config::default().world.tracks().door_hold_hits, 20);
         assert_eq!(Config::default().world.tracks().appeared_settle_s, 3.0);

@@ -17,10 +17,11 @@ pub const JAMB_M: f32 = 0.15;
 pub const LONE_JAMB_VIEWS: u16 = 3;
 
 impl Track {
-    /// A door frame only Method B has seen, not in a doorway of the map's walls, at a corner
-    /// of them: the end of a wall seen end-on looks like a jamb to Method B (an L-shaped
-    /// room's inner corner). Not reported while so.
-    pub fn door_at_corner(&self) -> bool {
+    /// A door frame only Method B has seen, not in a doorway of the map's walls, at a wall's
+    /// end: at a corner of them, or beside an end with no other jamb ([`Track::lone_jamb`]).
+    /// The end of a wall seen end-on looks like a jamb to Method B (an L-shaped room's inner
+    /// corner, a partition). Not reported while so.
+    pub fn door_at_wall_end(&self) -> bool {
         self.class() == ObjectClass::DoorFrame
             && (self.at_corner || self.lone_jamb())
             && !self.seen_a
@@ -98,21 +99,21 @@ impl Tracks {
                 View::Hidden => continue,
             };
             t.far_jamb_views[k] = t.far_jamb_views[k].saturating_add(1);
-            if t.door_at_corner() {
+            if t.door_at_wall_end() {
                 t.confirmed = false;
             }
         }
     }
 
     /// Door-frame tracks within [`CORNER_DOOR_M`] of a corner of the map's walls: see
-    /// [`Track::door_at_corner`]; one reported is reported no more. Also notes which stand
+    /// [`Track::door_at_wall_end`]; one reported is reported no more. Also notes which stand
     /// in a wall's line ([`Track::held_door`]).
     pub fn mark_corner_doors(&mut self, walls: &WallMap) {
         for t in self.tracks.iter_mut() {
             if t.class() == ObjectClass::DoorFrame {
                 t.at_corner = walls.corner_near(t.centre, CORNER_DOOR_M);
                 t.in_wall_line = walls.in_wall_line(t.centre);
-                if t.door_at_corner() {
+                if t.door_at_wall_end() {
                     t.confirmed = false;
                 }
             }

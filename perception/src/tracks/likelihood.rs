@@ -20,7 +20,7 @@ impl Track {
     /// A piece of furniture whose observations were, on the whole, the kind that is wrong more
     /// often than [`TrackConfig::min_likelihood`] allows (desks: or
     /// [`TrackConfig::min_desk_likelihood`]): not reported while so. Door frames are judged by
-    /// the map's walls instead ([`Track::door_at_corner`]).
+    /// the map's walls instead ([`Track::door_at_wall_end`]).
     pub fn unlikely(&self, cfg: &TrackConfig) -> bool {
         let least = match self.class() {
             ObjectClass::DoorFrame => return false,

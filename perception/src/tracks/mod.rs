@@ -19,8 +19,9 @@
 //!    as a doorway ([`Tracks::anchor_doors`]), or seen in [`TrackConfig::door_hold_hits`]
 //!    frames in a wall's line ([`Track::held_door`]), is an opening: rays through it are what
 //!    it looks like; it loses belief when its middle is seen closed, or when the rays pass its
-//!    jambs' places too (open floor). A door frame only Method B has seen, at a corner of the map's
-//!    walls and in no doorway of them, is not reported ([`Tracks::mark_corner_doors`]).
+//!    jambs' places too (open floor). A door frame only Method B has seen, at a wall's end (a
+//!    corner of the map's walls, or beside an end whose other jamb's place is seen empty) and
+//!    in no doorway of them, is not reported ([`Tracks::mark_wall_doors`]).
 //! 4. **New tracks** from unmatched observations (non-finite or absurd ones are refused and
 //!    counted); when the table is full the weakest tentative track, else the weakest track, is
 //!    evicted (counted).
@@ -290,7 +291,7 @@ fn earns_report(t: &Track, cfg: &TrackConfig) -> bool {
         && waited
         && t.hits >= cfg.confirm_hits
         && t.existence >= cfg.confirm_existence
-        && !t.door_at_corner();
+        && !t.door_at_wall_end();
     base && (t.agreed
         || (t.hits >= cfg.single_method_hits
             && t.hits as f32 >= cfg.single_method_rate * t.views as f32))
