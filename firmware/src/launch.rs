@@ -341,6 +341,8 @@ fn run_loop(
     // Frames at the LiDAR's pace: a port, or a simulation or replay in real time.
     let live = pacing == Pacing::RealTime || !(source.is_file() || source.is_simulated());
     let mut method_b = load_method_b(cfg, common, live)?;
+    // The world model's likelihood default depends on it (`config::world`).
+    let b_runs = method_b.is_some();
     if let Some(b) = method_b.as_mut() {
         b.mount = mount;
     }
@@ -388,7 +390,7 @@ fn run_loop(
         pose,
         method_a: cfg.method_a.enabled.then(|| (cfg.method_a(), mount)),
         method_b,
-        world: cfg.world.enabled.then(|| cfg.world.tracks()),
+        world: cfg.world.enabled.then(|| cfg.world.tracks(b_runs)),
     };
     let scheduling = crate::realtime::apply(cfg.runtime.scheduling, cfg.runtime.fifo_priority);
     log::info!("frame loop: {scheduling}");

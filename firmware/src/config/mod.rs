@@ -402,13 +402,9 @@ impl Config {
                 l.stale_after_ms
             ));
         }
-        within(
-            "world",
-            "min_likelihood",
-            self.world.min_likelihood,
-            0.0,
-            1.0,
-        )?;
+        if let Some(v) = self.world.min_likelihood {
+            within("world", "min_likelihood", v, 0.0, 1.0)?;
+        }
         within(
             "world",
             "desk_min_likelihood",
@@ -556,41 +552,48 @@ mod test {
         let bad: Config = toml::from_str("[world]\nmin_likelihood = 1.5\n").unwrap();
         assert!(bad.validate().unwrap_err().contains("world.min_likelihood"));
         // Set, it reaches the track table with the compiled-in calibration; unset, the
-        // default holds back what is right less than half the time.
+        // default holds back what is right less than half the time while Method B runs.
         let w: Config = toml::from_str("[world]\nmin_likelihood = 0.6\n").unwrap();
-        let t = w.world.tracks();
+        let t = w.world.tracks(true);
         assert_eq!(t.min_likelihood, 0.6);
         assert_ne!(
             t.calibration,
             perception::calibration::Calibration::IDENTITY
         );
-        assert_eq!(Config::default().world.tracks().min_likelihood, 0.5);
+        assert_eq!(Config::default().world.tracks(true).min_likelihood, 0.5);
+        // Method A alone: nothing held back unless asked for.
+        assert_eq!(Config::default().world.tracks(false).min_likelihood, 0.0);
         let w: Config = toml::from_str("[world]\nmin_likelihood = 0\n").unwrap();
-        assert_eq!(w.world.tracks().min_likelihood, 0.0);
-        assert_eq!(Config::default().world.tracks().min_desk_likelihood, 0.6);
-        assert_eq!(Config::default().world.tracks().door_hold_hits, 20);
-        assert_eq!(Config::default().world.tracks().appeared_settle_s, 3.0);
+        assert_eq!(w.world.tracks(true).min_likelihood, 0.0);
+        let w: Config = toml::from_str("[world]\nmin_likelihood = 0.7\n").unwrap();
+        assert_eq!(w.world.tracks(false).min_likelihood, 0.7);
+        assert_eq!(
+            Config::default().world.tracks(true).min_desk_likelihood,
+            0.6
+        );
+        assert_eq!(Config::default().world.tracks(true).door_hold_hits, 20);
+        assert_eq!(Config::default().world.tracks(true).appeared_settle_s, 3.0);
         let w: Config = toml::from_str("[world]\nappeared_settle_s = 0\n").unwrap();
-        assert_eq!(w.world.tracks().appeared_settle_s, 0.0);
-        assert_eq!(Config::default().world.tracks().miss_min_returns, 2);
+        assert_eq!(w.world.tracks(true).appeared_settle_s, 0.0);
+        assert_eq!(Config::default().world.tracks(true).miss_min_returns, 2);
         let w: Config = toml::from_str("[world]\nmiss_min_returns = 3\n").unwrap();
-        assert_eq!(w.world.tracks().miss_min_returns, 3);
+        assert_eq!(w.world.tracks(true).miss_min_returns, 3);
         let w: Config = toml::from_str("[world]\nmiss_min_returns = 0\n").unwrap();
         assert_eq!(
-            w.world.tracks().miss_min_returns,
+            w.world.tracks(true).miss_min_returns,
             1,
             "a miss needs a return"
         );
         let w: Config = toml::from_str("[world]\nsingle_method_hits = 0\n").unwrap();
         assert_eq!(
-            w.world.tracks().single_method_hits,
+            w.world.tracks(true).single_method_hits,
             1,
             "a report needs a hit"
         );
         let w: Config = toml::from_str("[world]\nsingle_method_hits = 12\n").unwrap();
-        assert_eq!(w.world.tracks().single_method_hits, 12);
+        assert_eq!(w.world.tracks(true).single_method_hits, 12);
         let w: Config = toml::from_str("[world]\ndoor_hold_hits = 0\n").unwrap();
-        assert_eq!(w.world.tracks().door_hold_hits, 0);
+        assert_eq!(w.world.tracks(true).door_hold_hits, 0);
         let bad: Config = toml::from_str("[method_b]\nconf = 1.5\n").unwrap();
         assert!(bad.validate().unwrap_err().contains("method_b.conf"));
         let bad: Config = toml::from_str("[method_b]\nthreads = 0\n").unwrap();

@@ -24,10 +24,10 @@ pub struct WorldSettings {
     /// than this is not reported: each detection's probability is how often detections of its
     /// source, class and score stood on a piece of their class in the simulator's tuning runs
     /// (`perception::calibration`, the counts compiled in from `models`), and a track's is
-    /// their mean (`perception::tracks::Track::likelihood`). 0.5 by default: held out it
-    /// cut phantoms in every family (the annex's by 12 %) and cost no piece; 0: every track
+    /// their mean (`perception::tracks::Track::likelihood`). Unset (the default): 0.5 while
+    /// Method B runs ([`MIN_LIKELIHOOD_WITH_B`]), 0 when Method A runs alone. 0: every track
     /// that earns a report is reported; 0.6 trades recall for precision (docs/world.md).
-    pub min_likelihood: f32,
+    pub min_likelihood: Option<f32>,
     /// The same for desks alone (the larger of the two applies to them): on by default, since
     /// on the tuning and the held-out runs it cost no desk (docs/world.md).
     pub desk_min_likelihood: f32,
@@ -54,6 +54,12 @@ pub struct WorldSettings {
     pub single_method_hits: u32,
 }
 
+/// `min_likelihood` while Method B runs, unless set: held out it cut phantoms in every family
+/// (the annex's by 12 %) and cost no piece (docs/world.md). It was measured with both methods
+/// running; with Method A alone it would hold back most of A's boxes and desks (right 31–60 %
+/// of the time at their usual scores), so there the default is 0.
+pub const MIN_LIKELIHOOD_WITH_B: f32 = 0.5;
+
 impl Default for WorldSettings {
     fn default() -> Self {
         let m = perception::motion::MotionConfig::default();
@@ -62,7 +68,7 @@ impl Default for WorldSettings {
             settle_s: m.settle_s,
             people: true,
             legs: false,
-            min_likelihood: 0.5,
+            min_likelihood: None,
             desk_min_likelihood: 0.6,
             door_hold_hits: 20,
             appeared_settle_s: 3.0,
@@ -73,8 +79,8 @@ impl Default for WorldSettings {
 }
 
 impl WorldSettings {
-    /// The track table's tuning these settings give.
-    pub fn tracks(&self) -> perception::tracks::TrackConfig {
+    /// The track table's tuning these settings give; `method_b`: whether Method B runs.
+    pub fn tracks(&self, method_b: bool) -> perception::tracks::TrackConfig {
         let mut c = perception::tracks::TrackConfig::default();
         c.motion.settle_s = if self.settle_s.is_finite() {
             self.settle_s.max(0.0)
@@ -86,8 +92,10 @@ impl WorldSettings {
         }
         c.walkers = self.people && self.legs;
         c.calibration = models::calibration::calibration();
-        if self.min_likelihood.is_finite() {
-            c.min_likelihood = self.min_likelihood.clamp(0.0, 1.0);
+        let min =
+            (self.min_likelihood).unwrap_or(if method_b { MIN_LIKELIHOOD_WITH_B } else { 0.0 });
+        if min.is_finite() {
+            c.min_likelihood = min.clamp(0.0, 1.0);
         }
         if self.desk_min_likelihood.is_finite() {
             c.min_desk_likelihood = self.desk_min_likelihood.clamp(0.0, 1.0);
