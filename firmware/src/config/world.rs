@@ -56,7 +56,7 @@ pub struct WorldSettings {
 
 /// `min_likelihood` while Method B runs, unless set: held out it cut phantoms in every family
 /// (the annex's by 12 %) and cost no piece (docs/world.md). It was measured with both methods
-/// running; with Method A alone it would hold back most of A's boxes and desks (right 31–60 %
+/// running; with Method A alone it would hold back most of A's boxes and desks (right 24–60 %
 /// of the time at their usual scores), so there the default is 0.
 pub const MIN_LIKELIHOOD_WITH_B: f32 = 0.5;
 
