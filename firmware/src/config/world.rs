@@ -25,7 +25,7 @@ pub struct WorldSettings {
     /// source, class and score stood on a piece of their class in the simulator's tuning runs
     /// (`perception::calibration`, the counts compiled in from `models`), and a track's is
     /// their mean (`perception::tracks::Track::likelihood`). Unset (the default): 0.5 while
-    /// Method B runs ([`MIN_LIKELIHOOD_WITH_B`]), 0 when Method A runs alone. 0: every track
+    /// Method B runs (`MIN_LIKELIHOOD_WITH_B`), 0 when Method A runs alone. 0: every track
     /// that earns a report is reported; 0.6 trades recall for precision (docs/world.md).
     pub min_likelihood: Option<f32>,
     /// The same for desks alone (the larger of the two applies to them): on by default, since
