@@ -92,8 +92,9 @@ impl WorldSettings {
         }
         c.walkers = self.people && self.legs;
         c.calibration = models::calibration::calibration();
-        let min =
-            (self.min_likelihood).unwrap_or(if method_b { MIN_LIKELIHOOD_WITH_B } else { 0.0 });
+        let min = self
+            .min_likelihood
+            .unwrap_or(if method_b { MIN_LIKELIHOOD_WITH_B } else { 0.0 });
         if min.is_finite() {
             c.min_likelihood = min.clamp(0.0, 1.0);
         }
