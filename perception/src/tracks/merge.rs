@@ -57,6 +57,7 @@ impl Tracks {
                 t.views = t.views.max(gone.views);
                 t.first_seen = t.first_seen.min(gone.first_seen);
                 t.last_seen = t.last_seen.max(gone.last_seen);
+                t.view_span = t.view_span.max(gone.view_span);
                 t.seen_a |= gone.seen_a;
                 t.seen_b |= gone.seen_b;
                 t.agreed |= gone.agreed;

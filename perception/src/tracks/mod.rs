@@ -31,6 +31,8 @@
 //!    hits in at least [`TrackConfig::single_method_rate`] of the frames it was in view;
 //!    furniture born where the rays had shown the floor empty ([`FreeFloor`], marked from every
 //!    revolution's rays) must also have been seen for [`TrackConfig::appeared_settle_s`];
+//!    it must be still ([`Motion::settled`]), except a desk seen from places
+//!    [`DESK_VIEW_SPAN_M`] apart with no reported desk within [`DESK_BESIDE_M`] (`report.rs`);
 //!    it is deleted when existence falls below [`TrackConfig::delete_existence`], or when a
 //!    tentative track goes unseen for [`TrackConfig::tentative_frames`]. A track out of view
 //!    keeps its state: an object behind the robot is still in the room.
@@ -42,7 +44,8 @@
 //! Files: `association.rs` (which observation updates which track), `merge.rs` (one object
 //! seen twice), `negative.rs` (what the rays say), `walkers.rs` (the leg detector's tracks),
 //! `door_marks.rs` (what the map's walls say of door frames), `outline_marks.rs` (what a box
-//! track's returns say of its shape), `likelihood.rs`.
+//! track's returns say of its shape), `report.rs` (when a track is reported; desks that never
+//! settle), `likelihood.rs`, `stats.rs` (the table's counters).
 
 use heapless::Vec;
 
@@ -58,6 +61,9 @@ use association::{cheapest, class_cost};
 pub use outline_marks::{
     AVERAGED_ROUND_MAJORITY, AVERAGED_ROUND_VIEWS, OUTLINE_SLOTS, averaged_vote,
 };
+pub use report::{DESK_BESIDE_M, DESK_VIEW_SPAN_M};
+use report::{desk_beside, earns_report};
+pub use stats::TrackStats;
 
 mod association;
 mod door_marks;
@@ -65,6 +71,8 @@ mod likelihood;
 mod merge;
 mod negative;
 mod outline_marks;
+mod report;
+mod stats;
 mod walkers;
 
 pub use door_marks::{JAMB_M, LONE_JAMB_VIEWS};
@@ -243,6 +251,10 @@ pub struct Track {
     /// Sum of its observations' probabilities ([`TrackConfig::calibration`]); over its hits,
     /// how likely what the methods saw there was right ([`Track::likelihood`]).
     pub p_sum: f32,
+    /// Where the LiDAR stood when it was first seen (map frame).
+    pub first_view: Point2,
+    /// How far from [`Track::first_view`] the LiDAR has seen it since, at most, m.
+    pub view_span: f32,
 }
 
 impl Track {
@@ -282,21 +294,6 @@ impl Track {
     }
 }
 
-/// Whether a track has the evidence to be reported: enough hits and existence, and unless
-/// both methods agreed on it in one frame, more hits and a steady detection rate while in
-/// view (Method A seeing it once and Method B once, in different frames, is not agreement).
-fn earns_report(t: &Track, cfg: &TrackConfig) -> bool {
-    let waited = !t.born_on_free || t.motion.age_s() >= cfg.appeared_settle_s;
-    let base = t.motion.settled(&cfg.motion)
-        && waited
-        && t.hits >= cfg.confirm_hits
-        && t.existence >= cfg.confirm_existence
-        && !t.door_at_wall_end();
-    base && (t.agreed
-        || (t.hits >= cfg.single_method_hits
-            && t.hits as f32 >= cfg.single_method_rate * t.views as f32))
-}
-
 /// Footprint radius of a class, m.
 fn class_radius(c: ObjectClass) -> f32 {
     match c {
@@ -305,25 +302,6 @@ fn class_radius(c: ObjectClass) -> f32 {
         ObjectClass::Desk => 0.9,
         ObjectClass::DoorFrame => 0.5,
     }
-}
-
-/// Counters of the track table.
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
-#[cfg_attr(feature = "defmt", derive(defmt::Format))]
-pub struct TrackStats {
-    /// Tracks created.
-    pub created: u64,
-    /// Tracks deleted (seen empty, or tentative and unseen).
-    pub deleted: u64,
-    /// Tracks evicted because the table was full.
-    pub evicted: u64,
-    /// Observations refused: a non-finite coordinate or score, or beyond
-    /// [`TrackConfig::max_observation_m`].
-    pub rejected: u64,
-    /// Frames whose pose could not be used (non-finite).
-    pub bad_poses: u64,
-    /// Tracks merged into another of their class (one object seen twice).
-    pub merged: u64,
 }
 
 /// The track table.
@@ -451,7 +429,16 @@ impl Tracks {
         }) {
             matched[i] = true;
             used[k] = true;
-            Self::hit(&mut self.tracks[i], &obs[k], frame, stamp_s, cfg);
+            let beside = desk_beside(&self.tracks, self.tracks[i].centre, Some(i));
+            Self::hit(
+                &mut self.tracks[i],
+                &obs[k],
+                frame,
+                stamp_s,
+                sensor,
+                beside,
+                cfg,
+            );
         }
         // Negative evidence for the unmatched tracks in view.
         if pose_ok {
@@ -515,8 +502,11 @@ impl Tracks {
                 in_wall_line: false,
                 far_jamb_views: [0; 2],
                 p_sum: 0.0,
+                first_view: sensor,
+                view_span: 0.0,
             };
-            Self::hit(&mut t, o, frame, stamp_s, cfg);
+            let beside = desk_beside(&self.tracks, o.centre, None);
+            Self::hit(&mut t, o, frame, stamp_s, sensor, beside, cfg);
             if self.tracks.push(t).is_ok() {
                 self.next_id = self.next_id.wrapping_add(1);
                 self.stats.created += 1;
@@ -528,7 +518,16 @@ impl Tracks {
         }
     }
 
-    fn hit(t: &mut Track, o: &FrameObject, frame: u64, stamp_s: f64, cfg: &TrackConfig) {
+    fn hit(
+        t: &mut Track,
+        o: &FrameObject,
+        frame: u64,
+        stamp_s: f64,
+        sensor: Point2,
+        beside_desk: bool,
+        cfg: &TrackConfig,
+    ) {
+        t.note_view(sensor);
         if t.hits > 0 {
             let legs = |c: ObjectClass| matches!(c, ObjectClass::Chair | ObjectClass::Box);
             let may_move = legs(o.class) && legs(t.class());
@@ -571,7 +570,7 @@ impl Tracks {
             // A walking person: where the legs are now, never furniture.
             t.centre = t.motion.pos;
             t.confirmed = false;
-        } else if earns_report(t, cfg) {
+        } else if earns_report(t, cfg, beside_desk) {
             t.confirmed = true;
         }
     }
@@ -1424,6 +1423,58 @@ mod test {
             step(&mut t, f, &o, &Pose2::IDENTITY, &far, &cfg);
         }
         assert_eq!(t.confirmed().count(), 2);
+    }
+
+    /// A desk Method B sees only now and then (every 8th revolution, 1.6 s: each sighting comes
+    /// after a gap, which resets the motion filter's stillness) is reported from a robot that
+    /// drives past it, once seen from places [`DESK_VIEW_SPAN_M`] apart; from one that stands
+    /// still it is not, and neither is a chair seen so, however the robot drives, nor a desk
+    /// seen so within [`DESK_BESIDE_M`] of a reported desk.
+    #[test]
+    fn a_desk_seen_now_and_then_from_a_driving_robot_is_reported() {
+        let cfg = TrackConfig::default();
+        let run = |class: ObjectClass, drive: f32| {
+            let mut t = Tracks::new();
+            for f in (0..160u64).step_by(8) {
+                let lidar = Pose2::new(drive * f as f32, 0.0, 0.0);
+                let o = obs(class, 3.0, 2.0, 0.9, Evidence::AB);
+                step(&mut t, f, &[o], &lidar, &ranges(0.0), &cfg);
+            }
+            assert_eq!(t.all().len(), 1);
+            let d = &t.all()[0];
+            (d.confirmed, d.view_span)
+        };
+        // A tour's 0.15 m/s: 0.03 m a revolution.
+        let (shown, span) = run(ObjectClass::Desk, 0.03);
+        assert!(shown && span >= DESK_VIEW_SPAN_M, "{span}");
+        assert_eq!(run(ObjectClass::Desk, 0.0), (false, 0.0));
+        assert!(!run(CHAIR, 0.03).0);
+        // Seen in every revolution it settles as anything else does, driving or not.
+        let mut t = Tracks::new();
+        for f in 0..20 {
+            let o = obs(ObjectClass::Desk, 3.0, 2.0, 0.9, Evidence::AB);
+            step(&mut t, f, &[o], &Pose2::IDENTITY, &ranges(0.0), &cfg);
+        }
+        assert!(t.all()[0].confirmed);
+        // Beside a desk that is reported (1.6 m: its other end, boxed on its own now and
+        // then) it must settle; 3.5 m off it is another desk.
+        for (x, shown) in [(4.6f32, false), (6.5, true)] {
+            let mut t = Tracks::new();
+            for f in 0..160u64 {
+                let lidar = Pose2::new(0.03 * f as f32, 0.0, 0.0);
+                let desk = obs(ObjectClass::Desk, 3.0, 2.0, 0.9, Evidence::AB);
+                let other = obs(ObjectClass::Desk, x, 2.0, 0.9, Evidence::AB);
+                let seen: &[FrameObject] = if f % 8 == 0 && f > 0 {
+                    &[desk, other]
+                } else {
+                    &[desk]
+                };
+                step(&mut t, f, seen, &lidar, &ranges(0.0), &cfg);
+            }
+            assert_eq!(t.all().len(), 2);
+            assert!(t.all()[0].confirmed);
+            assert_eq!(t.all()[1].confirmed, shown, "{x}");
+        }
     }
 
     #[test]
