@@ -429,7 +429,10 @@ impl Tracks {
         }) {
             matched[i] = true;
             used[k] = true;
-            let beside = desk_beside(&self.tracks, self.tracks[i].centre, Some(i));
+            // Only a desk, or a track this observation may make one, is asked (`report.rs`).
+            let desk = ObjectClass::Desk;
+            let beside = (self.tracks[i].class() == desk || obs[k].class == desk)
+                && desk_beside(&self.tracks, self.tracks[i].centre, Some(i));
             Self::hit(
                 &mut self.tracks[i],
                 &obs[k],
@@ -505,7 +508,7 @@ impl Tracks {
                 first_view: sensor,
                 view_span: 0.0,
             };
-            let beside = desk_beside(&self.tracks, o.centre, None);
+            let beside = o.class == ObjectClass::Desk && desk_beside(&self.tracks, o.centre, None);
             Self::hit(&mut t, o, frame, stamp_s, sensor, beside, cfg);
             if self.tracks.push(t).is_ok() {
                 self.next_id = self.next_id.wrapping_add(1);
