@@ -360,12 +360,14 @@ pub fn report(outcomes: &[Outcome]) -> String {
         let within2 = t.move_gone_s.iter().filter(|&&x| x <= 2.0).count();
         let _ = writeln!(
             s,
-            "  moved pieces: {} seen empty; gone within 2 s {}, later {}, still on the map {}, never seen empty {}",
+            "  moved pieces: {} seen empty; gone within 2 s {}, later {}, still on the map {}, never seen empty {}; reports at an old place not yet seen empty (no phantom) {:.3}/frame, {} in final maps",
             t.move_gone_s.len() + t.move_stuck as usize,
             within2,
             t.move_gone_s.len() - within2,
             t.move_stuck,
-            t.move_unseen
+            t.move_unseen,
+            f64::from(t.unrefuted) / f,
+            t.map_unrefuted
         );
         let _ = writeln!(
             s,

@@ -147,6 +147,14 @@ pub struct Tally {
     /// centre), at a wall face (within 0.15 m), anywhere else. Names: `PHANTOM_PLACES`.
     #[serde(default)]
     pub phantoms_where: [u32; 5],
+    /// Reports among `objects` (summed over frames) at the old place of a piece taken away or
+    /// moved before the LiDAR saw that place empty: no phantom, since nothing sensed says the
+    /// piece went (`unrefuted`). `phantoms` plus these is the count before that rule.
+    #[serde(default)]
+    pub unrefuted: u32,
+    /// The same among the final map's objects, which are then left out of `map_reported`.
+    #[serde(default)]
+    pub map_unrefuted: u32,
     /// Reported objects on furniture of another class (and none of their own within reach).
     pub wrong_class: u32,
     /// Frames with a `detections` list, and the phantoms among those detections by source.
@@ -206,6 +214,21 @@ pub struct Tally {
 
 /// Class names of the tally's per-class arrays.
 pub const CLASSES: [&str; 3] = ["chair", "box", "desk"];
+
+/// Whether `p` lies on the old place of a piece taken away or moved that the LiDAR has not yet
+/// seen empty by frame `fi`: nothing the robot has sensed says it went, so a map that keeps it
+/// (as a map must keep what is out of view) reports no phantom there, and no true piece either.
+/// From the frame its place is seen empty on, a report there is a phantom like any other.
+fn unrefuted(truth: &RunTruth, fi: usize, p: Point2) -> bool {
+    truth.moves.iter().any(|m| {
+        fi >= m.frame
+            && m.seen_empty.is_none_or(|s| fi < s)
+            && truth
+                .furniture
+                .get(m.before)
+                .is_some_and(|f| f.distance(p) <= MATCH_M)
+    })
+}
 
 fn on_furniture<'a>(
     alive: &'a [&'a Furniture],
@@ -270,7 +293,9 @@ pub fn score_run(truth: &RunTruth, lines: &[Line], tally: &mut Tally) {
                     }
                     c => {
                         let mut near = on_furniture(&alive, o.at).peekable();
-                        if near.peek().is_none() {
+                        if main && near.peek().is_none() && unrefuted(truth, fi, o.at) {
+                            tally.unrefuted += 1;
+                        } else if near.peek().is_none() {
                             phantoms[o.source] += 1;
                             if main {
                                 tally.phantoms_at_wall += u32::from(at_wall_face(truth, o.at));
@@ -342,6 +367,9 @@ pub fn score_run(truth: &RunTruth, lines: &[Line], tally: &mut Tally) {
             .objects
             .iter()
             .filter(|o| o.class.is_some_and(|c| c != ObjectClass::DoorFrame))
+            .filter(|o| {
+                !unrefuted(truth, fi, o.at) || alive.iter().any(|f| f.distance(o.at) <= MATCH_M)
+            })
             .collect();
         tally.id_gt += gt.len() as u32;
         tally.id_hyp += hyp.len() as u32;
@@ -444,6 +472,7 @@ pub fn score_run(truth: &RunTruth, lines: &[Line], tally: &mut Tally) {
                 tally.map_reported[ci] += 1;
                 tally.map_tp[ci] += 1;
             }
+            None if unrefuted(truth, fi, o.at) => tally.map_unrefuted += 1,
             None => tally.map_reported[ci] += 1,
         }
     }
@@ -517,6 +546,8 @@ impl Tally {
         );
         sum!(
             id_switches,
+            unrefuted,
+            map_unrefuted,
             phantoms_at_wall,
             move_stuck,
             move_unseen,
@@ -750,13 +781,49 @@ mod test {
         let mut s = Tally::default();
         score_run(&t, &lines, &mut s);
         // The box at (3, 3) is a phantom in every frame; the one at the moved box's old place
-        // is one from frame 1 on.
-        assert_eq!(s.phantoms, [0, 4, 3]);
+        // is one from frame 2 on, when the place was seen empty (in frame 1 nothing sensed
+        // had said it went).
+        assert_eq!(s.phantoms, [0, 4, 2]);
+        assert_eq!(s.unrefuted, 1);
         assert_eq!(s.wrong_class, 4);
         assert_eq!(s.move_stuck, 1);
         assert_eq!(s.map_tp, [0, 0, 0]);
         assert_eq!(s.map_visible, [1, 0, 0]);
         assert_eq!(s.map_reported, [0, 2, 1]);
+    }
+
+    #[test]
+    fn a_piece_taken_away_unseen_is_no_phantom_until_its_place_is_seen_empty() {
+        let mut t = truth();
+        t.moves.push(Move {
+            before: 1,
+            frame: 1,
+            seen_empty: None,
+        });
+        t.furniture[1].to_frame = 1;
+        let lines: Vec<Line> = (0..4)
+            .map(|k| Line {
+                t: 0.2 * f64::from(k),
+                objects: vec![obj(5, ObjectClass::Box, -1.0, 0.0)],
+                ..Line::default()
+            })
+            .collect();
+        let mut s = Tally::default();
+        score_run(&t, &lines, &mut s);
+        // On the box while it stood (frame 0), then kept where nothing said it went.
+        assert_eq!(s.phantoms, [0, 0, 0]);
+        assert_eq!(s.unrefuted, 3);
+        assert_eq!(s.move_unseen, 1);
+        // Neither a true nor a false entry of the final map, nor a hypothesis for identity.
+        assert_eq!(s.map_reported, [0, 0, 0]);
+        assert_eq!(s.map_unrefuted, 1);
+        assert_eq!((s.id_hyp, s.idtp), (1, 1));
+        // Seen empty at frame 2: a phantom from then on.
+        t.moves[0].seen_empty = Some(2);
+        let mut s = Tally::default();
+        score_run(&t, &lines, &mut s);
+        assert_eq!((s.phantoms, s.unrefuted), ([0, 0, 2], 1));
+        assert_eq!((s.map_reported, s.map_unrefuted), ([0, 1, 0], 0));
     }
 
     #[test]
