@@ -33,9 +33,9 @@
 //!    revolution's rays) must also have been seen for [`TrackConfig::appeared_settle_s`];
 //!    it must be still ([`Motion::settled`]), except a desk seen from places
 //!    [`DESK_VIEW_SPAN_M`] apart with no reported desk within [`DESK_BESIDE_M`] (`report.rs`);
-//!    it is deleted when existence falls below [`TrackConfig::delete_existence`], or when a
-//!    tentative track goes unseen for [`TrackConfig::tentative_frames`]. A track out of view
-//!    keeps its state: an object behind the robot is still in the room.
+//!    it is deleted when existence falls below [`Track::delete_below`] (once reported: the
+//!    floor, so a piece found again keeps its id), or when a track never reported goes unseen
+//!    for [`TrackConfig::tentative_frames`]. A track out of view keeps its state.
 //! 6. **Likelihood:** each observation's calibrated probability ([`TrackConfig::calibration`])
 //!    is summed; furniture whose mean is below [`TrackConfig::min_likelihood`] (desks:
 //!    [`TrackConfig::min_desk_likelihood`]) is not reported ([`Track::unlikely`],
@@ -43,9 +43,8 @@
 //!
 //! Files: `association.rs` (which observation updates which track), `merge.rs` (one object
 //! seen twice), `negative.rs` (what the rays say), `walkers.rs` (the leg detector's tracks),
-//! `door_marks.rs` (what the map's walls say of door frames), `outline_marks.rs` (what a box
-//! track's returns say of its shape), `report.rs` (when a track is reported; desks that never
-//! settle), `likelihood.rs`, `stats.rs` (the table's counters).
+//! `door_marks.rs` (the map's walls and door frames), `outline_marks.rs` (a box's shape),
+//! `report.rs` (when reported, when deleted), `likelihood.rs`, `stats.rs` (the counters).
 
 use heapless::Vec;
 
@@ -205,7 +204,7 @@ pub struct Track {
     pub views: u32,
     /// First and last frame with an observation.
     pub first_seen: u64,
-    /// Last frame with an observation.
+    /// See `first_seen`.
     pub last_seen: u64,
     /// Seen by Method A / by Method B so far.
     seen_a: bool,
@@ -214,6 +213,8 @@ pub struct Track {
     agreed: bool,
     /// Reported.
     pub confirmed: bool,
+    /// Reported at some time: deleted only at the existence floor ([`Track::delete_below`]).
+    pub reported_once: bool,
     /// Width across, m (door frames: the clear width, a running mean of the observations
     /// that carry one); 0 = unknown.
     pub width_m: f32,
@@ -460,9 +461,9 @@ impl Tracks {
         let mut i = 0;
         while i < self.tracks.len() {
             let t = &self.tracks[i];
-            let stale_tentative =
-                !t.confirmed && frame.saturating_sub(t.last_seen) > cfg.tentative_frames;
-            if t.existence < cfg.delete_existence || stale_tentative {
+            let stale_tentative = !(t.confirmed || t.reported_once)
+                && frame.saturating_sub(t.last_seen) > cfg.tentative_frames;
+            if t.existence < t.delete_below(cfg) || stale_tentative {
                 self.tracks.swap_remove(i);
                 self.stats.deleted += 1;
             } else {
@@ -491,6 +492,7 @@ impl Tracks {
                 seen_b: false,
                 agreed: false,
                 confirmed: false,
+                reported_once: false,
                 width_m: 0.0,
                 motion: Motion::new(o.centre, stamp_s),
                 born_on_free: o.class != ObjectClass::DoorFrame && self.floor.seen_free(o.centre),
@@ -574,7 +576,7 @@ impl Tracks {
             t.centre = t.motion.pos;
             t.confirmed = false;
         } else if earns_report(t, cfg, beside_desk) {
-            t.confirmed = true;
+            (t.confirmed, t.reported_once) = (true, true);
         }
     }
 
@@ -967,12 +969,79 @@ mod test {
         // It is carried away: the rays now reach the wall behind.
         let empty = ranges(3.4);
         let mut frames = 0;
-        while !t.all().is_empty() {
+        while t.confirmed().count() > 0 {
             frames += 1;
-            assert!(frames < 20, "still there after {frames} frames");
+            assert!(frames < 20, "still reported after {frames} frames");
             step(&mut t, 5 + frames, &[], &Pose2::IDENTITY, &empty, &cfg);
         }
-        assert!(frames <= 10, "gone within 2 s (10 frames): {frames}");
+        assert!(
+            frames <= 10,
+            "gone from the map within 2 s (10 frames): {frames}"
+        );
+        // Once reported, it is forgotten at the existence floor (`Track::delete_below`).
+        while !t.all().is_empty() {
+            frames += 1;
+            assert!(frames <= 15, "still in the table after {frames} frames");
+            step(&mut t, 5 + frames, &[], &Pose2::IDENTITY, &empty, &cfg);
+        }
+    }
+
+    #[test]
+    fn a_piece_the_methods_stop_finding_for_a_while_comes_back_under_its_id() {
+        // A box only Method B sees, 2 m ahead, its rays returning from it throughout.
+        let cfg = TrackConfig::default();
+        let mut scan = ranges(3.4);
+        for d in [358usize, 359, 0, 1, 2] {
+            scan[d] = 1.9;
+        }
+        let seen = [obs(ObjectClass::Box, 2.0, 0.0, 0.9, Evidence::B)];
+        let mut t = Tracks::new();
+        let mut f = 0u64;
+        while t.confirmed().count() == 0 {
+            assert!(f < 30, "never reported");
+            step(&mut t, f, &seen, &Pose2::IDENTITY, &scan, &cfg);
+            f += 1;
+        }
+        let (id, first) = (t.all()[0].id, f);
+        // Seen in every revolution for 8 s; then Method B loses it for 2.4 s from where the
+        // robot is now: misses in plain view take it off the map ...
+        while f < 40 {
+            step(&mut t, f, &seen, &Pose2::IDENTITY, &scan, &cfg);
+            f += 1;
+        }
+        for _ in 0..12 {
+            step(&mut t, f, &[], &Pose2::IDENTITY, &scan, &cfg);
+            f += 1;
+        }
+        assert_eq!(
+            t.confirmed().count(),
+            0,
+            "a piece missed for 2.4 s is not reported"
+        );
+        let kept = t.all()[0];
+        assert!(kept.existence < cfg.delete_existence, "{kept:?}");
+        assert_eq!(t.all().len(), 1, "but the table keeps what it had reported");
+        // ... and it is found again: the same track, reported in fewer frames than it first
+        // took.
+        let again = f;
+        while t.confirmed().count() == 0 {
+            assert!(f < again + 30, "never reported again");
+            step(&mut t, f, &seen, &Pose2::IDENTITY, &scan, &cfg);
+            f += 1;
+        }
+        assert_eq!(t.all()[0].id, id);
+        assert!(
+            f - again < first,
+            "back in {} frames, first in {first}",
+            f - again
+        );
+        // A tentative track never reported is still forgotten when unseen.
+        let mut u = Tracks::new();
+        step(&mut u, 0, &seen, &Pose2::IDENTITY, &scan, &cfg);
+        for g in 1..=cfg.tentative_frames + 1 {
+            step(&mut u, g, &[], &Pose2::IDENTITY, &ranges(0.0), &cfg);
+        }
+        assert!(u.all().is_empty(), "{:?}", u.all());
     }
 
     #[test]
@@ -1003,7 +1072,7 @@ mod test {
             // Carried away; or a LiDAR that returns nothing at all (nothing can be said).
             let after = if blinded { ranges(0.0) } else { room };
             let mut frames = 0;
-            while !t.all().is_empty() && frames < 20 {
+            while t.confirmed().count() > 0 && frames < 20 {
                 frames += 1;
                 step(&mut t, 5 + frames, &[], &Pose2::IDENTITY, &after, &cfg);
             }
@@ -1599,7 +1668,7 @@ mod test {
         assert_eq!((chair.hits, chair.views), (10, 10));
         // What the rays show needs no method: its place seen empty, it goes, Method B or not.
         let through = ranges(3.0);
-        let mut gone = None;
+        let (mut unreported, mut gone) = (None, None);
         for f in 20..40u64 {
             let looked = Looked { a: true, b: false };
             t.update(
@@ -1611,12 +1680,20 @@ mod test {
                 looked,
                 &cfg,
             );
+            if t.confirmed().count() == 0 {
+                unreported.get_or_insert(f);
+            }
             if t.all().is_empty() {
                 gone = Some(f);
                 break;
             }
         }
-        assert!(gone.is_some_and(|f| f < 30), "deleted at {gone:?}");
+        assert!(
+            unreported.is_some_and(|f| f < 30),
+            "reported until {unreported:?}"
+        );
+        // Forgotten at the existence floor, as a piece once reported is.
+        assert!(gone.is_some_and(|f| f < 40), "deleted at {gone:?}");
     }
 
     #[test]

@@ -1,4 +1,5 @@
-//! When a track is reported ([`earns_report`]), and desks that never settle. A desk never
+//! When a track is reported ([`earns_report`]) and when it is deleted
+//! ([`Track::delete_below`]), and desks that never settle. A desk never
 //! walks (`Motion::observe`'s `may_move`), yet one that Method B sees only now and then is
 //! never still by the motion test ([`crate::motion::Motion::settled`]): each sighting follows
 //! a gap, which resets the stillness the test counts, and the centre wanders with the view as
@@ -45,6 +46,19 @@ impl Track {
         let span = sensor.distance(self.first_view);
         if span.is_finite() && span > self.view_span {
             self.view_span = span;
+        }
+    }
+
+    /// The existence below which it is deleted: [`TrackConfig::delete_existence`], or for a
+    /// track once reported, just above the floor (`-existence_cap`). A piece Method B stops
+    /// finding for a while (from another side, farther off) is then no longer reported but
+    /// kept, and its next detections bring it back under its id, not a new track that must
+    /// earn its report again. Its place seen empty takes it to the floor as fast as before.
+    pub fn delete_below(&self, cfg: &TrackConfig) -> f32 {
+        if self.reported_once {
+            cfg.delete_existence.min(0.99 * -cfg.existence_cap)
+        } else {
+            cfg.delete_existence
         }
     }
 
