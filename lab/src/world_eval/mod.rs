@@ -12,6 +12,7 @@ mod places;
 pub mod reliability;
 pub mod score;
 pub mod sim_family;
+mod unrefuted;
 
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};

@@ -11,6 +11,7 @@ pub use super::assignment::max_assignment;
 pub use super::places::{BESIDE_M, CLUTTER_M, DOORWAY_M, PHANTOM_PLACES, WALL_FACE_M};
 use super::places::{at_wall_face, phantom_place};
 use super::reliability;
+use super::unrefuted::unrefuted;
 use crate::eval_a::class_index;
 use crate::run_truth::{Furniture, PERSON_VISIBLE_RETURNS, Person, RunTruth};
 
@@ -149,7 +150,7 @@ pub struct Tally {
     pub phantoms_where: [u32; 5],
     /// Reports among `objects` (summed over frames) at the old place of a piece taken away or
     /// moved before the LiDAR saw that place empty: no phantom, since nothing sensed says the
-    /// piece went (`unrefuted`). `phantoms` plus these is the count before that rule.
+    /// piece went (`unrefuted.rs`). `phantoms` plus these is the count before that rule.
     #[serde(default)]
     pub unrefuted: u32,
     /// The same among the final map's objects, which are then left out of `map_reported`.
@@ -215,21 +216,6 @@ pub struct Tally {
 /// Class names of the tally's per-class arrays.
 pub const CLASSES: [&str; 3] = ["chair", "box", "desk"];
 
-/// Whether `p` lies on the old place of a piece taken away or moved that the LiDAR has not yet
-/// seen empty by frame `fi`: nothing the robot has sensed says it went, so a map that keeps it
-/// (as a map must keep what is out of view) reports no phantom there, and no true piece either.
-/// From the frame its place is seen empty on, a report there is a phantom like any other.
-fn unrefuted(truth: &RunTruth, fi: usize, p: Point2) -> bool {
-    truth.moves.iter().any(|m| {
-        fi >= m.frame
-            && m.seen_empty.is_none_or(|s| fi < s)
-            && truth
-                .furniture
-                .get(m.before)
-                .is_some_and(|f| f.distance(p) <= MATCH_M)
-    })
-}
-
 fn on_furniture<'a>(
     alive: &'a [&'a Furniture],
     p: Point2,
@@ -293,7 +279,7 @@ pub fn score_run(truth: &RunTruth, lines: &[Line], tally: &mut Tally) {
                     }
                     c => {
                         let mut near = on_furniture(&alive, o.at).peekable();
-                        if main && near.peek().is_none() && unrefuted(truth, fi, o.at) {
+                        if main && near.peek().is_none() && unrefuted(truth, fi, o.at, MATCH_M) {
                             tally.unrefuted += 1;
                         } else if near.peek().is_none() {
                             phantoms[o.source] += 1;
@@ -368,7 +354,8 @@ pub fn score_run(truth: &RunTruth, lines: &[Line], tally: &mut Tally) {
             .iter()
             .filter(|o| o.class.is_some_and(|c| c != ObjectClass::DoorFrame))
             .filter(|o| {
-                !unrefuted(truth, fi, o.at) || alive.iter().any(|f| f.distance(o.at) <= MATCH_M)
+                !unrefuted(truth, fi, o.at, MATCH_M)
+                    || alive.iter().any(|f| f.distance(o.at) <= MATCH_M)
             })
             .collect();
         tally.id_gt += gt.len() as u32;
@@ -472,7 +459,7 @@ pub fn score_run(truth: &RunTruth, lines: &[Line], tally: &mut Tally) {
                 tally.map_reported[ci] += 1;
                 tally.map_tp[ci] += 1;
             }
-            None if unrefuted(truth, fi, o.at) => tally.map_unrefuted += 1,
+            None if unrefuted(truth, fi, o.at, MATCH_M) => tally.map_unrefuted += 1,
             None => tally.map_reported[ci] += 1,
         }
     }
