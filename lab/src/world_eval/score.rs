@@ -354,8 +354,7 @@ pub fn score_run(truth: &RunTruth, lines: &[Line], tally: &mut Tally) {
             .iter()
             .filter(|o| o.class.is_some_and(|c| c != ObjectClass::DoorFrame))
             .filter(|o| {
-                !unrefuted(truth, fi, o.at, MATCH_M)
-                    || alive.iter().any(|f| f.distance(o.at) <= MATCH_M)
+                !unrefuted(truth, fi, o.at, MATCH_M) || on_furniture(&alive, o.at).next().is_some()
             })
             .collect();
         tally.id_gt += gt.len() as u32;
