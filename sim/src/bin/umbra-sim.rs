@@ -35,6 +35,7 @@ enum Kind {
     Rect,
     Lshape,
     Tworooms,
+    Notch,
 }
 
 #[derive(Subcommand)]
@@ -147,6 +148,7 @@ fn kinds(k: &[Kind]) -> Vec<RoomKind> {
             Kind::Rect => RoomKind::Rect,
             Kind::Lshape => RoomKind::LShape,
             Kind::Tworooms => RoomKind::TwoRooms,
+            Kind::Notch => RoomKind::Notch,
         })
         .collect()
 }

@@ -191,6 +191,11 @@ pub enum RoomKind {
     LShape,
     /// Two rectangles joined by a corridor.
     TwoRooms,
+    /// A rectangle with a notch cut into the middle of one side (a U, or a room around an
+    /// alcove of the building): two inner corners, each the end of a wall seen end-on from
+    /// much of the room, as an L-shaped room's one is. For training Method B on inner corners
+    /// while the L-shaped room stays its unseen kind (`models/README.md`).
+    Notch,
 }
 
 impl RoomKind {
@@ -200,6 +205,7 @@ impl RoomKind {
             RoomKind::Rect => "rect",
             RoomKind::LShape => "lshape",
             RoomKind::TwoRooms => "tworooms",
+            RoomKind::Notch => "notch",
         }
     }
 }
@@ -312,14 +318,36 @@ impl World {
         let kind = kinds[b.rng.random_range(0..kinds.len())];
         let p = Point2::new;
         match kind {
-            RoomKind::Rect | RoomKind::LShape => {
+            RoomKind::Rect | RoomKind::LShape | RoomKind::Notch => {
                 // Varied worlds: rooms up to 11 m, larger than the LiDAR reaches.
                 let side = if varied { 11.0 } else { 8.0 };
-                let w = b.rng.random_range(3.0..side);
+                // A notched room needs two arms beside its notch.
+                let w_min = if kind == RoomKind::Notch { 4.0 } else { 3.0 };
+                let w = b.rng.random_range(w_min..side);
                 let h = b.rng.random_range(3.0..side);
                 let outline: Vec<Point2> = if kind == RoomKind::Rect {
                     b.floor.push((p(0.0, 0.0), p(w, h)));
                     vec![p(0.0, 0.0), p(w, 0.0), p(w, h), p(0.0, h)]
+                } else if kind == RoomKind::Notch {
+                    // The notch: 25–45 % of the width, its left side 20 % of the width or more
+                    // from the left wall, 30–50 % of the depth deep.
+                    let nw = b.rng.random_range(0.25..0.45) * w;
+                    let a0 = b.rng.random_range(0.2 * w..(0.8 * w - nw));
+                    let a1 = a0 + nw;
+                    let c = b.rng.random_range(0.3..0.5) * h;
+                    b.floor.push((p(0.0, 0.0), p(w, h - c)));
+                    b.floor.push((p(0.0, h - c), p(a0, h)));
+                    b.floor.push((p(a1, h - c), p(w, h)));
+                    vec![
+                        p(0.0, 0.0),
+                        p(w, 0.0),
+                        p(w, h),
+                        p(a1, h),
+                        p(a1, h - c),
+                        p(a0, h - c),
+                        p(a0, h),
+                        p(0.0, h),
+                    ]
                 } else {
                     let a = b.rng.random_range(0.35..0.6) * w;
                     let c = b.rng.random_range(0.35..0.6) * h;
@@ -457,6 +485,7 @@ impl World {
         let name = match self.kind {
             RoomKind::Rect => "rectangular room",
             RoomKind::LShape => "L-shaped room",
+            RoomKind::Notch => "notched room",
             RoomKind::TwoRooms => "two rooms and a corridor",
         };
         format!(
@@ -576,7 +605,12 @@ mod test {
 
     #[test]
     fn all_kinds_generate_with_furniture_and_clear_start() {
-        for kind in [RoomKind::Rect, RoomKind::LShape, RoomKind::TwoRooms] {
+        for kind in [
+            RoomKind::Rect,
+            RoomKind::LShape,
+            RoomKind::TwoRooms,
+            RoomKind::Notch,
+        ] {
             let cfg = WorldConfig {
                 kinds: vec![kind],
                 ..WorldConfig::default()
