@@ -108,7 +108,8 @@ pub struct TrackConfig {
     pub tentative_frames: u64,
     /// Existence gained per hit, times the observation's score.
     pub hit_gain: f32,
-    /// Existence lost when the place is seen empty.
+    /// Existence lost when the place is seen empty: more than a hit gains (rays returned from
+    /// beyond a footprint outweigh one detection; `docs/world.md`, 35th session).
     pub free_loss: f32,
     /// Existence lost in a frame whose revolution had the track in plain view (in range, its
     /// bearing not blocked by anything nearer) and no observation matched it.
@@ -164,7 +165,7 @@ impl Default for TrackConfig {
             delete_existence: -1.0,
             tentative_frames: 10,
             hit_gain: 1.0,
-            free_loss: 1.0,
+            free_loss: 1.5,
             miss_loss: 0.7,
             miss_min_returns: 1,
             single_method_hits: 8,
@@ -974,14 +975,13 @@ mod test {
             assert!(frames < 20, "still reported after {frames} frames");
             step(&mut t, 5 + frames, &[], &Pose2::IDENTITY, &empty, &cfg);
         }
-        assert!(
-            frames <= 10,
-            "gone from the map within 2 s (10 frames): {frames}"
-        );
+        // Seen empty in every revolution, it leaves well within the goal's 2 s (10 frames):
+        // three revolutions take it from the cap below the report threshold (`free_loss`).
+        assert!(frames <= 4, "gone from the map within 0.8 s (4 frames): {frames}");
         // Once reported, it is forgotten at the existence floor (`Track::delete_below`).
         while !t.all().is_empty() {
             frames += 1;
-            assert!(frames <= 15, "still in the table after {frames} frames");
+            assert!(frames <= 10, "still in the table after {frames} frames");
             step(&mut t, 5 + frames, &[], &Pose2::IDENTITY, &empty, &cfg);
         }
     }
