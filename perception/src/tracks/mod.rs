@@ -977,7 +977,10 @@ mod test {
         }
         // Seen empty in every revolution, it leaves well within the goal's 2 s (10 frames):
         // three revolutions take it from the cap below the report threshold (`free_loss`).
-        assert!(frames <= 4, "gone from the map within 0.8 s (4 frames): {frames}");
+        assert!(
+            frames <= 4,
+            "gone from the map within 0.8 s (4 frames): {frames}"
+        );
         // Once reported, it is forgotten at the existence floor (`Track::delete_below`).
         while !t.all().is_empty() {
             frames += 1;
