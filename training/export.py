@@ -22,6 +22,7 @@ import numpy as np
 
 import logits_head
 import offline  # noqa: F401
+import qat_ranges
 from ultralytics import YOLO
 
 
@@ -42,7 +43,11 @@ def ultralytics_onnx(weights: Path) -> Path:
     return Path(f)
 
 
-def quantise(fp32: Path, out: Path, calib: Path, n: int, per_channel: bool = False) -> None:
+def quantise(fp32: Path, out: Path, calib: Path, n: int, per_channel: bool = False,
+             ranges: dict | None = None) -> None:
+    """`fp32` as int8 in `out`, calibrated on the first `n` PNGs of `calib`; `ranges`:
+    onnxruntime `TensorQuantOverrides` that replace the measured ranges of those tensors
+    (a quantisation-aware run's, `qat_ranges.overrides`)."""
     from onnxruntime.quantization import (CalibrationDataReader, QuantFormat, QuantType,
                                           quantize_static)
 
@@ -60,6 +65,7 @@ def quantise(fp32: Path, out: Path, calib: Path, n: int, per_channel: bool = Fal
         str(fp32), str(out), Reader(), quant_format=QuantFormat.QOperator,
         op_types_to_quantize=["Conv"], per_channel=per_channel, activation_type=QuantType.QUInt8,
         weight_type=QuantType.QInt8,
+        extra_options={"TensorQuantOverrides": ranges} if ranges else None,
     )
 
 
@@ -85,7 +91,11 @@ def main() -> None:
     print(f"wrote {fp32}")
     if a.calib:
         q = out / "umbra-yolov8n-int8.onnx"
-        quantise(fp32, q, Path(a.calib), a.calib_images, a.per_channel)
+        ranges = qat_ranges.overrides(Path(a.weights), fp32)
+        if ranges:
+            print(f"int8 on the ranges its quantisation-aware run trained through "
+                  f"({len(ranges)} tensors)")
+        quantise(fp32, q, Path(a.calib), a.calib_images, a.per_channel, ranges)
         print(f"wrote {q}")
 
 

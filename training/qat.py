@@ -25,7 +25,9 @@ and exports Q/DQ nodes, which tract runs in float: not the model we ship.
 `models/README.md`), and tract runs that form 2-3 times slower on the Pis.
 
 `--strip` writes an ordinary Ultralytics checkpoint (the fake quantisation taken out, optimizer
-state dropped); `export.py` makes its fp32 and int8 files like any other's.
+state dropped) that keeps the ranges it trained through (`qat_ranges.py`): `export.py` makes
+its fp32 file like any other's, and its int8 file on those ranges rather than ones measured
+again on the trained weights.
 """
 
 import argparse
@@ -40,6 +42,7 @@ from torch import nn
 
 import train as train_mod
 from exact import ExactTrainer
+from qat_ranges import RANGES_KEY
 from ultralytics.nn.modules import Conv
 
 # The int8 model's integer ranges: activations uint8, weights int8 symmetric (onnxruntime
@@ -179,11 +182,14 @@ class QATTrainer(ExactTrainer):
 def strip_checkpoint(src: Path, dst: Path) -> None:
     ckpt = torch.load(str(src), map_location="cpu", weights_only=False)
     model = ckpt.get("ema") or ckpt["model"]
+    ranges = {name: m.q_range.tolist() for name, m in model.named_modules()
+              if isinstance(m, (QConv, QConv2d))}
     n = strip(model.float())
     ckpt.update(model=model.half(), ema=None, optimizer=None, updates=None,
                 train_results=None)
+    ckpt[RANGES_KEY] = ranges  # the ranges it trained through, for export.py
     torch.save(ckpt, str(dst))
-    print(f"wrote {dst}: {n} layers back to float convolutions")
+    print(f"wrote {dst}: {n} layers back to float convolutions, their ranges kept")
 
 
 def main() -> None:

@@ -12,6 +12,10 @@ environment, `.venv/bin/python training/test_training.py DATASET/data.yaml`).
   calibrated on the same N images, computes — far closer to it than the float model is (the
   rest is the integer accumulators' rounding, about one output step), with weights rounded
   per tensor and per output channel alike.
+* the ranges a quantisation-aware run trained through (`qat_ranges.py`): kept in a
+  checkpoint, they must land on every convolution's input and output tensors of the exported
+  graph, and the int8 file made on them must compute what the fake quantisation computes even
+  when the images it is calibrated on would give other ranges.
 """
 
 import shutil
@@ -131,7 +135,53 @@ def test_qat_emulates_int8(data: Path, calib: int = 32, per_channel: bool = Fals
           f"|float - int8| {fl:.3f}")
 
 
+def test_qat_ranges_carried(data: Path, calib: int = 32) -> None:
+    import onnx
+    import onnxruntime as ort
+    import torch
+    from ultralytics import YOLO
+
+    import logits_head
+    import qat
+    import qat_ranges
+    from export import png_tensor, quantise, ultralytics_onnx
+
+    tmp = Path(tempfile.mkdtemp())
+    shutil.copy(HERE.parent / "models/yolo/umbra-yolov8n.pt", tmp / "m.pt")
+    f32 = tmp / "m.onnx"
+    logits_head.cut(ultralytics_onnx(tmp / "m.pt"), f32)
+    folder = data.parent / "images" / "train"
+    model = YOLO(str(tmp / "m.pt")).model.float().eval()
+    qat.prepare(model, qat.calibration_tensors(folder, calib))
+    ckpt = torch.load(str(tmp / "m.pt"), map_location="cpu", weights_only=False)
+    ckpt[qat_ranges.RANGES_KEY] = {name: m.q_range.tolist() for name, m in model.named_modules()
+                                   if isinstance(m, (qat.QConv, qat.QConv2d))}
+    torch.save(ckpt, str(tmp / "r.pt"))
+    ranges = qat_ranges.overrides(tmp / "r.pt", f32)
+    convs = [n for n in onnx.load(str(f32)).graph.node if n.op_type == "Conv"]
+    missing = [n.name for n in convs if n.input[0] not in ranges or n.output[0] not in ranges]
+    assert convs and not missing, f"convolutions without ranges: {missing}"
+    # Calibrated on 2 images, the export would measure ranges of its own; the overrides win.
+    quantise(f32, tmp / "with.onnx", folder, 2, ranges=ranges)
+    quantise(f32, tmp / "without.onnx", folder, 2)
+    run = {k: ort.InferenceSession(str(tmp / f"{k}.onnx"), providers=["CPUExecutionProvider"])
+           for k in ("with", "without")}
+    off: dict[str, list[float]] = {"with": [], "without": []}
+    for f in sorted((data.parent / "images" / "test").glob("*.png"))[:10]:
+        x = png_tensor(f)
+        with torch.no_grad():
+            d = model(torch.from_numpy(x))[1]
+        emu = torch.cat([d["boxes"], d["scores"]], 1).numpy()
+        for k in off:
+            off[k].append(float(np.abs(emu - run[k].run(None, {"images": x})[0]).mean()))
+    w, wo = float(np.mean(off["with"])), float(np.mean(off["without"]))
+    assert w < 0.5 * wo, f"int8 on the kept ranges off the emulation by {w:.3f}, without {wo:.3f}"
+    print(f"qat ranges: {len(convs)} convolutions, {len(ranges)} tensors; mean |emulated - int8| "
+          f"{w:.3f} on the kept ranges, {wo:.3f} on ranges measured again")
+
+
 if __name__ == "__main__":
+    test_qat_ranges_carried(Path(sys.argv[1]))
     test_qat_emulates_int8(Path(sys.argv[1]))
     test_qat_emulates_int8(Path(sys.argv[1]), per_channel=True)
     test_logits_head(Path(sys.argv[1]))

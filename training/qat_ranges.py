@@ -1,0 +1,84 @@
+"""The activation ranges a quantisation-aware run trained through, carried into its int8 file.
+
+`qat.py` measures each quantised convolution's input and output range once, before training,
+and the network then learns through rounding on those ranges. The weights move while it
+trains, so the ranges `export.py` would measure again on the trained float weights are not
+the ones it learnt with: from rn45 (models/README.md, qat45) some layers' ranges came out
+twice as wide, and the int8 file lost 0.13 mAP50-95 that the fake quantisation had not. So
+`qat.py --strip` keeps the ranges in the checkpoint (`RANGES_KEY`), and `export.py` hands
+them to onnxruntime's quantiser as overrides (`overrides`), each on the ONNX tensors of the
+convolution it belongs to. Convolutions are matched by their weights (batch norm folded in,
+as both the export and the fake quantisation fold it), not by name, since the exported
+graph's node names do not follow the module tree one to one.
+"""
+
+from pathlib import Path
+
+import numpy as np
+
+# Where `qat.py --strip` keeps the ranges: {module name: [in lo, in hi, out lo, out hi]}.
+RANGES_KEY = "qat_ranges"
+
+
+def folded_weight(module) -> np.ndarray:
+    """A quantised convolution's weights as the exported graph holds them: an Ultralytics
+    `Conv` block's with its batch norm folded in (running statistics), a bare one's as they are."""
+    import torch
+
+    with torch.no_grad():
+        bn = getattr(module, "bn", None)
+        if bn is not None:
+            conv = module.conv
+            g = bn.weight.float() / torch.sqrt(bn.running_var.float() + bn.eps)
+            w = conv.weight.float() * g.view(-1, 1, 1, 1)
+        else:
+            w = module.weight.float()
+    return w.numpy()
+
+
+def overrides(checkpoint: Path, onnx_path: Path) -> dict:
+    """onnxruntime's `TensorQuantOverrides` for `onnx_path` from the ranges kept in
+    `checkpoint`: `{tensor: [{"rmin": lo, "rmax": hi}]}` for every convolution's input and
+    output. Empty when the checkpoint has none (not from a quantisation-aware run). A
+    convolution of the graph with no layer whose weights match raises, as does a layer
+    matched twice: the ranges would be put on the wrong tensors."""
+    import onnx
+    import torch
+    from onnx import numpy_helper
+
+    ckpt = torch.load(str(checkpoint), map_location="cpu", weights_only=False)
+    ranges = ckpt.get(RANGES_KEY)
+    if not ranges:
+        return {}
+    model = (ckpt.get("ema") or ckpt["model"]).float()
+    layers = {name: folded_weight(m) for name, m in model.named_modules() if name in ranges}
+    graph = onnx.load(str(onnx_path)).graph
+    inits = {i.name: i for i in graph.initializer}
+    out: dict = {}
+    used: set = set()
+
+    def widen(tensor: str, lo: float, hi: float) -> None:
+        # A tensor read by two convolutions (the head's two branches) has one range.
+        if tensor in out:
+            lo, hi = min(lo, out[tensor][0]["rmin"]), max(hi, out[tensor][0]["rmax"])
+        out[tensor] = [{"rmin": np.float32(lo), "rmax": np.float32(hi)}]
+
+    for node in graph.node:
+        if node.op_type != "Conv" or node.input[1] not in inits:
+            continue
+        w = numpy_helper.to_array(inits[node.input[1]]).astype(np.float32)
+        best, err = None, np.inf
+        for name, lw in layers.items():
+            if lw.shape == w.shape:
+                e = float(np.abs(lw - w).max() / (np.abs(w).max() + 1e-12))
+                if e < err:
+                    best, err = name, e
+        if best is None or err > 1e-3:
+            raise SystemExit(f"qat ranges: no layer matches {node.name} (best {best}, {err:.2g})")
+        if best in used:
+            raise SystemExit(f"qat ranges: {best} matches two convolutions")
+        used.add(best)
+        r = ranges[best]
+        widen(node.input[0], r[0], r[1])
+        widen(node.output[0], r[2], r[3])
+    return out
