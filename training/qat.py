@@ -120,22 +120,24 @@ def calibration_tensors(folder: Path, n: int) -> list[torch.Tensor]:
 
 
 @torch.no_grad()
-def prepare(model: nn.Module, images: list[torch.Tensor], per_channel: bool = False) -> int:
+def prepare(model: nn.Module, images: list[torch.Tensor], per_channel: bool = False,
+            ranges: str = "max") -> int:
     """Measures each quantised convolution's input and output range over `images` and turns it
     into its fake-quantised class, its weights rounded per tensor or per output channel.
-    Returns how many layers were prepared."""
+    `ranges`: "max", the extremes over all the images (what onnxruntime's MinMax calibration
+    measures), or "mean", the mean of each image's extremes (narrower: finer steps, more
+    clipping). Returns how many layers were prepared."""
     layers = list(quantised_layers(model))
-    seen: dict[str, list[float]] = {name: [0.0, 0.0, 0.0, 0.0] for name, _, _ in layers}
+    per_image: dict[str, list[list[float]]] = {name: [] for name, _, _ in layers}
     hooks = []
     for name, m, out in layers:
         def on_in(mod, args, name=name):
             x = args[0]
-            r = seen[name]
-            r[0], r[1] = min(r[0], float(x.min())), max(r[1], float(x.max()))
+            per_image[name].append([float(x.min()), float(x.max()), 0.0, 0.0])
 
         def on_out(mod, args, y, name=name):
-            r = seen[name]
-            r[2], r[3] = min(r[2], float(y.min())), max(r[3], float(y.max()))
+            r = per_image[name][-1]
+            r[2], r[3] = float(y.min()), float(y.max())
 
         hooks += [m.register_forward_pre_hook(on_in), out.register_forward_hook(on_out)]
     was = model.training
@@ -146,7 +148,13 @@ def prepare(model: nn.Module, images: list[torch.Tensor], per_channel: bool = Fa
         h.remove()
     model.train(was)
     for name, m, _ in layers:
-        m.register_buffer("q_range", torch.tensor(seen[name], dtype=torch.float32))
+        r = torch.tensor(per_image[name], dtype=torch.float32).reshape(-1, 4)
+        if ranges == "mean":
+            q = r.mean(0)
+        else:
+            q = torch.stack([r[:, 0].min(), r[:, 1].max(), r[:, 2].min(), r[:, 3].max()])
+        m.register_buffer("q_range", q.clamp(max=0.0) * torch.tensor([1.0, 0, 1, 0])
+                          + q.clamp(min=0.0) * torch.tensor([0.0, 1, 0, 1]))
         m.__class__ = QConv if isinstance(m, Conv) else QConv2d
         m.per_channel = per_channel
     return len(layers)
@@ -169,10 +177,11 @@ class QATTrainer(ExactTrainer):
 
     calib: list[torch.Tensor] = []
     per_channel = False
+    ranges = "max"
 
     def get_model(self, cfg=None, weights=None, verbose=True):
         model = super().get_model(cfg, weights, verbose)
-        n = prepare(model, self.calib, self.per_channel)
+        n = prepare(model, self.calib, self.per_channel, self.ranges)
         form = "per channel" if self.per_channel else "per tensor"
         print(f"qat: {n} convolutions fake-quantised ({form} weights) on {len(self.calib)} "
               "calibration images")
@@ -200,6 +209,9 @@ def main() -> None:
     ap.add_argument("--calib-images", type=int, default=256)
     ap.add_argument("--per-channel", action="store_true",
                     help="round weights per output channel (export with `export.py --per-channel`)")
+    ap.add_argument("--ranges", choices=("max", "mean"), default="max",
+                    help="activation ranges: extremes over the calibration images, or the mean "
+                    "of each image's")
     ap.add_argument("--epochs", type=int, default=2)
     ap.add_argument("--batch", type=int, default=32)
     ap.add_argument("--lr0", type=float, default=1e-4)
@@ -224,6 +236,7 @@ def main() -> None:
         ap.error("--data, --init (or --resume) and --calib are needed to train")
     qat.QATTrainer.calib = calibration_tensors(a.calib, a.calib_images)
     qat.QATTrainer.per_channel = a.per_channel
+    qat.QATTrainer.ranges = a.ranges
     t0 = time.time()
     w = train_mod.train(Path(a.data), a.epochs, a.batch, a.seed, a.device, a.workers, a.name,
                         a.resume, init=a.init, lr0=a.lr0, trainer=qat.QATTrainer)
