@@ -44,10 +44,10 @@ def ultralytics_onnx(weights: Path) -> Path:
 
 
 def quantise(fp32: Path, out: Path, calib: Path, n: int, per_channel: bool = False,
-             ranges: dict | None = None) -> None:
+             ranges: dict | None = None, exclude: tuple[str, ...] = ()) -> None:
     """`fp32` as int8 in `out`, calibrated on the first `n` PNGs of `calib`; `ranges`:
     onnxruntime `TensorQuantOverrides` that replace the measured ranges of those tensors
-    (a quantisation-aware run's, `qat_ranges.overrides`)."""
+    (a quantisation-aware run's, `qat_ranges.overrides`); `exclude`: convolutions left float."""
     from onnxruntime.quantization import (CalibrationDataReader, QuantFormat, QuantType,
                                           quantize_static)
 
@@ -64,7 +64,7 @@ def quantise(fp32: Path, out: Path, calib: Path, n: int, per_channel: bool = Fal
     quantize_static(
         str(fp32), str(out), Reader(), quant_format=QuantFormat.QOperator,
         op_types_to_quantize=["Conv"], per_channel=per_channel, activation_type=QuantType.QUInt8,
-        weight_type=QuantType.QInt8,
+        weight_type=QuantType.QInt8, nodes_to_exclude=list(exclude),
         extra_options={"TensorQuantOverrides": ranges} if ranges else None,
     )
 
@@ -77,6 +77,9 @@ def main() -> None:
     ap.add_argument("--calib-images", type=int, default=256)
     ap.add_argument("--per-channel", action="store_true",
                     help="int8 weights per output channel (as `qat.py --per-channel` trains)")
+    ap.add_argument("--float-head", action="store_true",
+                    help="int8: leave the head's six output convolutions float (as `qat.py "
+                    "--float-head` trains)")
     ap.add_argument("--full-head", action="store_true",
                     help="keep the DFL and box decoding in the graph (1x8x504)")
     a = ap.parse_args()
@@ -91,11 +94,14 @@ def main() -> None:
     print(f"wrote {fp32}")
     if a.calib:
         q = out / "umbra-yolov8n-int8.onnx"
-        ranges = qat_ranges.overrides(Path(a.weights), fp32)
+        import onnx
+
+        skip = tuple(qat_ranges.head_outputs(onnx.load(str(fp32)).graph)) if a.float_head else ()
+        ranges = qat_ranges.overrides(Path(a.weights), fp32, skip)
         if ranges:
             print(f"int8 on the ranges its quantisation-aware run trained through "
                   f"({len(ranges)} tensors)")
-        quantise(fp32, q, Path(a.calib), a.calib_images, a.per_channel, ranges)
+        quantise(fp32, q, Path(a.calib), a.calib_images, a.per_channel, ranges, skip)
         print(f"wrote {q}")
 
 

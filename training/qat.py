@@ -98,14 +98,15 @@ class QConv2d(nn.Conv2d):
         return fq_act(y, r[2], r[3])
 
 
-def quantised_layers(model: nn.Module):
-    """(name, module, output-producing module) of every convolution the int8 export quantises."""
+def quantised_layers(model: nn.Module, float_head: bool = False):
+    """(name, module, output-producing module) of every convolution the int8 export quantises;
+    `float_head`: not the head's bare output convolutions (`export.py --float-head`)."""
     for name, m in model.named_modules():
         if "dfl" in name:
             continue  # the DFL is decoded in float by the runtime, not in the graph
         if isinstance(m, Conv) and isinstance(getattr(m, "bn", None), nn.BatchNorm2d):
             yield name, m, m.bn
-        elif type(m) is nn.Conv2d and not name.endswith(".conv"):
+        elif type(m) is nn.Conv2d and not name.endswith(".conv") and not float_head:
             yield name, m, m  # a bare convolution, not the inside of a Conv block
 
 
@@ -121,13 +122,14 @@ def calibration_tensors(folder: Path, n: int) -> list[torch.Tensor]:
 
 @torch.no_grad()
 def prepare(model: nn.Module, images: list[torch.Tensor], per_channel: bool = False,
-            ranges: str = "max") -> int:
+            ranges: str = "max", float_head: bool = False) -> int:
     """Measures each quantised convolution's input and output range over `images` and turns it
     into its fake-quantised class, its weights rounded per tensor or per output channel.
     `ranges`: "max", the extremes over all the images (what onnxruntime's MinMax calibration
     measures), or "mean", the mean of each image's extremes (narrower: finer steps, more
-    clipping). Returns how many layers were prepared."""
-    layers = list(quantised_layers(model))
+    clipping). `float_head`: the head's output convolutions stay float. Returns how many
+    layers were prepared."""
+    layers = list(quantised_layers(model, float_head))
     per_image: dict[str, list[list[float]]] = {name: [] for name, _, _ in layers}
     hooks = []
     for name, m, out in layers:
@@ -178,10 +180,11 @@ class QATTrainer(ExactTrainer):
     calib: list[torch.Tensor] = []
     per_channel = False
     ranges = "max"
+    float_head = False
 
     def get_model(self, cfg=None, weights=None, verbose=True):
         model = super().get_model(cfg, weights, verbose)
-        n = prepare(model, self.calib, self.per_channel, self.ranges)
+        n = prepare(model, self.calib, self.per_channel, self.ranges, self.float_head)
         form = "per channel" if self.per_channel else "per tensor"
         print(f"qat: {n} convolutions fake-quantised ({form} weights) on {len(self.calib)} "
               "calibration images")
@@ -212,6 +215,9 @@ def main() -> None:
     ap.add_argument("--ranges", choices=("max", "mean"), default="max",
                     help="activation ranges: extremes over the calibration images, or the mean "
                     "of each image's")
+    ap.add_argument("--float-head", action="store_true",
+                    help="leave the head's six output convolutions float (export with "
+                    "`export.py --float-head`)")
     ap.add_argument("--epochs", type=int, default=2)
     ap.add_argument("--batch", type=int, default=32)
     ap.add_argument("--lr0", type=float, default=1e-4)
@@ -237,6 +243,7 @@ def main() -> None:
     qat.QATTrainer.calib = calibration_tensors(a.calib, a.calib_images)
     qat.QATTrainer.per_channel = a.per_channel
     qat.QATTrainer.ranges = a.ranges
+    qat.QATTrainer.float_head = a.float_head
     t0 = time.time()
     w = train_mod.train(Path(a.data), a.epochs, a.batch, a.seed, a.device, a.workers, a.name,
                         a.resume, init=a.init, lr0=a.lr0, trainer=qat.QATTrainer)

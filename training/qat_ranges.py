@@ -36,10 +36,18 @@ def folded_weight(module) -> np.ndarray:
     return w.numpy()
 
 
-def overrides(checkpoint: Path, onnx_path: Path) -> dict:
+def head_outputs(graph) -> list[str]:
+    """Names of the convolutions no activation follows: the detection head's outputs (every
+    other convolution of the graph is an Ultralytics `Conv` block's, a SiLU after it)."""
+    activated = {n.input[0] for n in graph.node if n.op_type == "Sigmoid"}
+    return [n.name for n in graph.node if n.op_type == "Conv" and n.output[0] not in activated]
+
+
+def overrides(checkpoint: Path, onnx_path: Path, skip: tuple[str, ...] = ()) -> dict:
     """onnxruntime's `TensorQuantOverrides` for `onnx_path` from the ranges kept in
     `checkpoint`: `{tensor: [{"rmin": lo, "rmax": hi}]}` for every convolution's input and
-    output. Empty when the checkpoint has none (not from a quantisation-aware run). A
+    output, but those named in `skip` (left float). Empty when the checkpoint has none (not
+    from a quantisation-aware run). A
     convolution of the graph with no layer whose weights match raises, as does a layer
     matched twice: the ranges would be put on the wrong tensors."""
     import onnx
@@ -64,7 +72,7 @@ def overrides(checkpoint: Path, onnx_path: Path) -> dict:
         out[tensor] = [{"rmin": np.float32(lo), "rmax": np.float32(hi)}]
 
     for node in graph.node:
-        if node.op_type != "Conv" or node.input[1] not in inits:
+        if node.op_type != "Conv" or node.input[1] not in inits or node.name in skip:
             continue
         w = numpy_helper.to_array(inits[node.input[1]]).astype(np.float32)
         best, err = None, np.inf
