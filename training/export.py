@@ -96,8 +96,9 @@ def main() -> None:
         q = out / "umbra-yolov8n-int8.onnx"
         import onnx
 
-        skip = tuple(qat_ranges.head_outputs(onnx.load(str(fp32)).graph)) if a.float_head else ()
-        ranges = qat_ranges.overrides(Path(a.weights), fp32, skip)
+        graph = onnx.load(str(fp32)).graph
+        skip = tuple(qat_ranges.head_outputs(graph)) if a.float_head else ()
+        ranges = qat_ranges.overrides(Path(a.weights), graph, skip)
         if ranges:
             print(f"int8 on the ranges its quantisation-aware run trained through "
                   f"({len(ranges)} tensors)")

@@ -42,13 +42,16 @@ from torch import nn
 
 import train as train_mod
 from exact import ExactTrainer
-from qat_ranges import RANGES_KEY
 from ultralytics.nn.modules import Conv
 
 # The int8 model's integer ranges: activations uint8, weights int8 symmetric (onnxruntime
 # quantises weights on [-127, 127]).
 A_MIN, A_MAX = 0, 255
 W_MAX = 127
+
+# Where `--strip` keeps the ranges a run trained through, for `export.py` (`qat_ranges.py`):
+# {module name: [in lo, in hi, out lo, out hi]}.
+RANGES_KEY = "qat_ranges"
 
 
 def fq_act(x: torch.Tensor, lo: float, hi: float) -> torch.Tensor:
@@ -70,16 +73,22 @@ def fq_weight(w: torch.Tensor, per_channel: bool = False) -> torch.Tensor:
     return torch.fake_quantize_per_tensor_affine(w, scale, 0, -W_MAX, W_MAX)
 
 
+def folded(block: Conv) -> tuple[torch.Tensor, torch.Tensor]:
+    """An Ultralytics `Conv` block's weights and bias with its batch norm folded in (running
+    statistics, frozen), as the exported graph holds them."""
+    bn = block.bn
+    g = bn.weight / torch.sqrt(bn.running_var + bn.eps)
+    return block.conv.weight * g.view(-1, 1, 1, 1), bn.bias - bn.running_mean * g
+
+
 class QConv(Conv):
     """Ultralytics' Conv (conv, batch norm, SiLU) as the int8 export computes it."""
 
     per_channel = False  # weights rounded per output channel (`prepare` sets it per layer)
 
     def forward(self, x):
-        bn, conv = self.bn, self.conv
-        g = bn.weight / torch.sqrt(bn.running_var + bn.eps)
-        w = conv.weight * g.view(-1, 1, 1, 1)
-        b = bn.bias - bn.running_mean * g
+        conv = self.conv
+        w, b = folded(self)
         r = self.q_range.tolist()
         y = F.conv2d(fq_act(x, r[0], r[1]), fq_weight(w, self.per_channel), b, conv.stride,
                      conv.padding, conv.dilation, conv.groups)
@@ -151,15 +160,19 @@ def prepare(model: nn.Module, images: list[torch.Tensor], per_channel: bool = Fa
     model.train(was)
     for name, m, _ in layers:
         r = torch.tensor(per_image[name], dtype=torch.float32).reshape(-1, 4)
-        if ranges == "mean":
-            q = r.mean(0)
-        else:
-            q = torch.stack([r[:, 0].min(), r[:, 1].max(), r[:, 2].min(), r[:, 3].max()])
-        m.register_buffer("q_range", q.clamp(max=0.0) * torch.tensor([1.0, 0, 1, 0])
-                          + q.clamp(min=0.0) * torch.tensor([0.0, 1, 0, 1]))
+        lo = (r[:, 0::2].mean(0) if ranges == "mean" else r[:, 0::2].amin(0)).clamp(max=0.0)
+        hi = (r[:, 1::2].mean(0) if ranges == "mean" else r[:, 1::2].amax(0)).clamp(min=0.0)
+        # [in lo, in hi, out lo, out hi], zero always inside (as onnxruntime keeps it)
+        m.register_buffer("q_range", torch.stack([lo[0], hi[0], lo[1], hi[1]]))
         m.__class__ = QConv if isinstance(m, Conv) else QConv2d
         m.per_channel = per_channel
     return len(layers)
+
+
+def trained_ranges(model: nn.Module) -> dict[str, list[float]]:
+    """The ranges each fake-quantised convolution of `model` rounds on, by module name."""
+    return {name: m.q_range.tolist() for name, m in model.named_modules()
+            if isinstance(m, (QConv, QConv2d))}
 
 
 def strip(model: nn.Module) -> int:
@@ -194,8 +207,7 @@ class QATTrainer(ExactTrainer):
 def strip_checkpoint(src: Path, dst: Path) -> None:
     ckpt = torch.load(str(src), map_location="cpu", weights_only=False)
     model = ckpt.get("ema") or ckpt["model"]
-    ranges = {name: m.q_range.tolist() for name, m in model.named_modules()
-              if isinstance(m, (QConv, QConv2d))}
+    ranges = trained_ranges(model)
     n = strip(model.float())
     ckpt.update(model=model.half(), ema=None, optimizer=None, updates=None,
                 train_results=None)

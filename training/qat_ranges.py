@@ -5,35 +5,26 @@ and the network then learns through rounding on those ranges. The weights move w
 trains, so the ranges `export.py` would measure again on the trained float weights are not
 the ones it learnt with: from rn45 (models/README.md, qat45) some layers' ranges came out
 twice as wide, and the int8 file lost 0.13 mAP50-95 that the fake quantisation had not. So
-`qat.py --strip` keeps the ranges in the checkpoint (`RANGES_KEY`), and `export.py` hands
+`qat.py --strip` keeps the ranges in the checkpoint (`qat.RANGES_KEY`), and `export.py` hands
 them to onnxruntime's quantiser as overrides (`overrides`), each on the ONNX tensors of the
 convolution it belongs to. Convolutions are matched by their weights (batch norm folded in,
 as both the export and the fake quantisation fold it), not by name, since the exported
 graph's node names do not follow the module tree one to one.
 """
 
-from pathlib import Path
-
 import numpy as np
+import torch
+from onnx import numpy_helper
 
-# Where `qat.py --strip` keeps the ranges: {module name: [in lo, in hi, out lo, out hi]}.
-RANGES_KEY = "qat_ranges"
+import qat
 
 
+@torch.no_grad()
 def folded_weight(module) -> np.ndarray:
     """A quantised convolution's weights as the exported graph holds them: an Ultralytics
-    `Conv` block's with its batch norm folded in (running statistics), a bare one's as they are."""
-    import torch
-
-    with torch.no_grad():
-        bn = getattr(module, "bn", None)
-        if bn is not None:
-            conv = module.conv
-            g = bn.weight.float() / torch.sqrt(bn.running_var.float() + bn.eps)
-            w = conv.weight.float() * g.view(-1, 1, 1, 1)
-        else:
-            w = module.weight.float()
-    return w.numpy()
+    `Conv` block's with its batch norm folded in (`qat.folded`), a bare one's as they are."""
+    w = qat.folded(module)[0] if getattr(module, "bn", None) is not None else module.weight
+    return w.float().numpy()
 
 
 def head_outputs(graph) -> list[str]:
@@ -43,24 +34,19 @@ def head_outputs(graph) -> list[str]:
     return [n.name for n in graph.node if n.op_type == "Conv" and n.output[0] not in activated]
 
 
-def overrides(checkpoint: Path, onnx_path: Path, skip: tuple[str, ...] = ()) -> dict:
-    """onnxruntime's `TensorQuantOverrides` for `onnx_path` from the ranges kept in
-    `checkpoint`: `{tensor: [{"rmin": lo, "rmax": hi}]}` for every convolution's input and
-    output, but those named in `skip` (left float). Empty when the checkpoint has none (not
-    from a quantisation-aware run). A
-    convolution of the graph with no layer whose weights match raises, as does a layer
-    matched twice: the ranges would be put on the wrong tensors."""
-    import onnx
-    import torch
-    from onnx import numpy_helper
-
+def overrides(checkpoint, graph, skip: tuple[str, ...] = ()) -> dict:
+    """onnxruntime's `TensorQuantOverrides` for the ONNX `graph` from the ranges kept in
+    `checkpoint` (a path): `{tensor: [{"rmin": lo, "rmax": hi}]}` for every convolution's
+    input and output, but those named in `skip` (left float). Empty when the checkpoint has
+    none (not from a quantisation-aware run). A convolution of the graph with no layer whose
+    weights match raises, as does a layer matched twice: the ranges would be put on the wrong
+    tensors."""
     ckpt = torch.load(str(checkpoint), map_location="cpu", weights_only=False)
-    ranges = ckpt.get(RANGES_KEY)
+    ranges = ckpt.get(qat.RANGES_KEY)
     if not ranges:
         return {}
     model = (ckpt.get("ema") or ckpt["model"]).float()
     layers = {name: folded_weight(m) for name, m in model.named_modules() if name in ranges}
-    graph = onnx.load(str(onnx_path)).graph
     inits = {i.name: i for i in graph.initializer}
     out: dict = {}
     used: set = set()

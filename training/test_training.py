@@ -154,11 +154,11 @@ def test_qat_ranges_carried(data: Path, calib: int = 32) -> None:
     model = YOLO(str(tmp / "m.pt")).model.float().eval()
     qat.prepare(model, qat.calibration_tensors(folder, calib))
     ckpt = torch.load(str(tmp / "m.pt"), map_location="cpu", weights_only=False)
-    ckpt[qat_ranges.RANGES_KEY] = {name: m.q_range.tolist() for name, m in model.named_modules()
-                                   if isinstance(m, (qat.QConv, qat.QConv2d))}
+    ckpt[qat.RANGES_KEY] = qat.trained_ranges(model)
     torch.save(ckpt, str(tmp / "r.pt"))
-    ranges = qat_ranges.overrides(tmp / "r.pt", f32)
-    convs = [n for n in onnx.load(str(f32)).graph.node if n.op_type == "Conv"]
+    graph = onnx.load(str(f32)).graph
+    ranges = qat_ranges.overrides(tmp / "r.pt", graph)
+    convs = [n for n in graph.node if n.op_type == "Conv"]
     missing = [n.name for n in convs if n.input[0] not in ranges or n.output[0] not in ranges]
     assert convs and not missing, f"convolutions without ranges: {missing}"
     # Calibrated on 2 images, the export would measure ranges of its own; the overrides win.
