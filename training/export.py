@@ -79,7 +79,7 @@ def main() -> None:
                     help="int8 weights per output channel (as `qat.py --per-channel` trains)")
     ap.add_argument("--float-head", action="store_true",
                     help="int8: leave the head's six output convolutions float (as `qat.py "
-                    "--float-head` trains)")
+                    "--float-head` trains; a checkpoint of such a run is recognised without it)")
     ap.add_argument("--full-head", action="store_true",
                     help="keep the DFL and box decoding in the graph (1x8x504)")
     a = ap.parse_args()
@@ -97,7 +97,11 @@ def main() -> None:
         import onnx
 
         graph = onnx.load(str(fp32)).graph
-        skip = tuple(qat_ranges.head_outputs(graph)) if a.float_head else ()
+        float_head = a.float_head or qat_ranges.trained_float_head(Path(a.weights))
+        if float_head and not a.float_head:
+            print("int8: the head's output convolutions stay float, as its quantisation-aware "
+                  "run trained them")
+        skip = tuple(qat_ranges.head_outputs(graph)) if float_head else ()
         ranges = qat_ranges.overrides(Path(a.weights), graph, skip)
         if ranges:
             print(f"int8 on the ranges its quantisation-aware run trained through "

@@ -34,6 +34,21 @@ def head_outputs(graph) -> list[str]:
     return [n.name for n in graph.node if n.op_type == "Conv" and n.output[0] not in activated]
 
 
+def trained_float_head(checkpoint) -> bool:
+    """Whether `checkpoint` (a path) is from a quantisation-aware run that left the head's
+    output convolutions float (`qat.py --float-head`): it has ranges, and none of them is a
+    bare convolution's (`qat.quantised_layers`), so its int8 file must leave those float too.
+    `export.py` reads it so that no flag has to be repeated, in `make_model.py` or by hand."""
+    ckpt = torch.load(str(checkpoint), map_location="cpu", weights_only=False)
+    ranges = ckpt.get(qat.RANGES_KEY)
+    if not ranges:
+        return False
+    model = (ckpt.get("ema") or ckpt["model"]).float()
+    body = {name for name, _, _ in qat.quantised_layers(model, float_head=True)}
+    bare = {name for name, _, _ in qat.quantised_layers(model)} - body
+    return bool(body & set(ranges)) and not bare & set(ranges)
+
+
 def overrides(checkpoint, graph, skip: tuple[str, ...] = ()) -> dict:
     """onnxruntime's `TensorQuantOverrides` for the ONNX `graph` from the ranges kept in
     `checkpoint` (a path): `{tensor: [{"rmin": lo, "rmax": hi}]}` for every convolution's
