@@ -2,7 +2,7 @@
 """Count each frame stage's instructions on the Pis' instruction sets under qemu, and project
 the stage times on a Pi 5 and a Pi 3 (docs/pi-budget.md says how and how far to trust it).
 
-    python3 bench/pi/budget.py [--frames 3,13] [--json OUT.json]
+    python3 bench/pi/budget.py [--frames 3,13] [--json OUT.json] [--int8 MODEL.onnx]
 
 Needs gcc, qemu-user (qemu-aarch64, qemu-arm) and the cross-built static binaries of the CI's
 cross stage (target/<triple>/release/umbra, features method-b). For every board it runs
@@ -120,7 +120,11 @@ def main() -> None:
     ap.add_argument("--check", type=Path, metavar="BASELINE.json")
     ap.add_argument("--update", type=Path, metavar="BASELINE.json")
     ap.add_argument("--tolerance", type=float, default=0.15)
+    ap.add_argument("--int8", type=Path, metavar="MODEL.onnx",
+                    help="count this file for the int8 stage instead of the shipped one")
     a = ap.parse_args()
+    if a.int8:
+        SETS["b_int8"] = (False, True, a.int8.resolve())
     f0, f1 = (int(x) for x in a.frames.split(","))
     if not 3 <= f0 < f1:
         sys.exit("--frames: need 3 <= first < second")
