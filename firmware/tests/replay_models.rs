@@ -34,8 +34,16 @@ fn replay(model: LidarModel, dir: &std::path::Path) -> (Vec<Value>, String) {
         })
         .collect();
     std::fs::write(&odom, lines.join("\n")).unwrap();
+    // No frame degraded for time: the overrun policy ages more of Method A's cloud after a frame
+    // whose Method A ran over its budget (`[runtime] deadline_ms`' share), and a debug build on a
+    // loaded machine does (seen in a CI run: 10 of 40 objects matched). What is compared here
+    // is the models' bytes, not the machine's speed.
     let cfg = dir.join("cfg.toml");
-    std::fs::write(&cfg, "[method_b]\nenabled = false\n").unwrap();
+    std::fs::write(
+        &cfg,
+        "[method_b]\nenabled = false\n[runtime]\ndeadline_ms = 10000\n",
+    )
+    .unwrap();
     let jsonl = dir.join(format!("{}.jsonl", model.cli_name()));
     let mut cmd = Command::new(env!("CARGO_BIN_EXE_umbra"));
     cmd.arg("replay").arg(&cap);
