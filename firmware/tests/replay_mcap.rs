@@ -42,10 +42,16 @@ fn a_recorded_run_replays_to_the_same_frames() {
     let rec = d.join("run.mcap");
     let live = d.join("live.jsonl");
     let again = d.join("replay.jsonl");
+    // No frame degraded for time in either run: the overrun policy's choices follow the
+    // machine's speed, which a recording does not carry (`replay_models.rs`).
+    let cfg = d.join("cfg.toml");
+    std::fs::write(&cfg, "[runtime]\ndeadline_ms = 10000\n").unwrap();
     let out = Command::new(env!("CARGO_BIN_EXE_umbra"))
         .args([
             "run", "--frames", "24", "--speed", "max", "--seed", "4", "--quiet",
         ])
+        .arg("--config")
+        .arg(&cfg)
         .arg("--record")
         .arg(&rec)
         .arg("--jsonl")
@@ -61,6 +67,8 @@ fn a_recorded_run_replays_to_the_same_frames() {
     let out = Command::new(env!("CARGO_BIN_EXE_umbra"))
         .args(["replay", "--quiet"])
         .arg(&rec)
+        .arg("--config")
+        .arg(&cfg)
         .arg("--jsonl")
         .arg(&again)
         .env("RUST_LOG", "info")
