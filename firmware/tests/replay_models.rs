@@ -36,9 +36,9 @@ fn replay(model: LidarModel, dir: &std::path::Path) -> (Vec<Value>, String) {
     std::fs::write(&odom, lines.join("\n")).unwrap();
     // No frame degraded for time: the overrun policy ages more of Method A's cloud after a frame
     // whose Method A ran over its budget (`[runtime] deadline_ms`' share, 65 ms). On a loaded
-    // machine one frame of a run can (seen: the LDS-02's and the A2's runs each had one frame of
-    // 103–106 ms, marked `degraded`, and matched 10 and 31 of 40 objects). What is compared
-    // here is the models' bytes, not the machine's speed.
+    // machine one frame of a run can (seen: in the LDS-02's and the A2's runs one frame's
+    // Method A took 103–106 ms, the next was `degraded`, and they matched 10 and 31 of 40
+    // objects). What is compared here is the models' bytes, not the machine's speed.
     let cfg = dir.join("cfg.toml");
     std::fs::write(
         &cfg,
