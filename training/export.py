@@ -97,12 +97,13 @@ def main() -> None:
         import onnx
 
         graph = onnx.load(str(fp32)).graph
-        float_head = a.float_head or qat_ranges.trained_float_head(Path(a.weights))
+        trained = qat_ranges.kept(Path(a.weights))
+        float_head = a.float_head or qat_ranges.trained_float_head(trained)
         if float_head and not a.float_head:
             print("int8: the head's output convolutions stay float, as its quantisation-aware "
                   "run trained them")
         skip = tuple(qat_ranges.head_outputs(graph)) if float_head else ()
-        ranges = qat_ranges.overrides(Path(a.weights), graph, skip)
+        ranges = qat_ranges.overrides(trained, graph, skip)
         if ranges:
             print(f"int8 on the ranges its quantisation-aware run trained through "
                   f"({len(ranges)} tensors)")

@@ -34,33 +34,40 @@ def head_outputs(graph) -> list[str]:
     return [n.name for n in graph.node if n.op_type == "Conv" and n.output[0] not in activated]
 
 
-def trained_float_head(checkpoint) -> bool:
-    """Whether `checkpoint` (a path) is from a quantisation-aware run that left the head's
-    output convolutions float (`qat.py --float-head`): it has ranges, and none of them is a
-    bare convolution's (`qat.quantised_layers`), so its int8 file must leave those float too.
-    `export.py` reads it so that no flag has to be repeated, in `make_model.py` or by hand."""
+def kept(checkpoint) -> tuple[dict, object]:
+    """The ranges a quantisation-aware run kept in `checkpoint` (a path) and its model (float),
+    loaded once for `trained_float_head` and `overrides`; `({}, None)` when it kept none (not
+    from a quantisation-aware run)."""
     ckpt = torch.load(str(checkpoint), map_location="cpu", weights_only=False)
     ranges = ckpt.get(qat.RANGES_KEY)
     if not ranges:
+        return {}, None
+    return ranges, (ckpt.get("ema") or ckpt["model"]).float()
+
+
+def trained_float_head(trained: tuple[dict, object]) -> bool:
+    """Whether a checkpoint (`kept`'s answer) is from a quantisation-aware run that left the
+    head's output convolutions float (`qat.py --float-head`): it has ranges, and none of them is
+    a bare convolution's (`qat.quantised_layers`), so its int8 file must leave those float too.
+    `export.py` reads it so that no flag has to be repeated, in `make_model.py` or by hand."""
+    ranges, model = trained
+    if not ranges:
         return False
-    model = (ckpt.get("ema") or ckpt["model"]).float()
     body = {name for name, _, _ in qat.quantised_layers(model, float_head=True)}
     bare = {name for name, _, _ in qat.quantised_layers(model)} - body
     return bool(body & set(ranges)) and not bare & set(ranges)
 
 
-def overrides(checkpoint, graph, skip: tuple[str, ...] = ()) -> dict:
-    """onnxruntime's `TensorQuantOverrides` for the ONNX `graph` from the ranges kept in
-    `checkpoint` (a path): `{tensor: [{"rmin": lo, "rmax": hi}]}` for every convolution's
+def overrides(trained: tuple[dict, object], graph, skip: tuple[str, ...] = ()) -> dict:
+    """onnxruntime's `TensorQuantOverrides` for the ONNX `graph` from the ranges a checkpoint
+    kept (`kept`'s answer): `{tensor: [{"rmin": lo, "rmax": hi}]}` for every convolution's
     input and output, but those named in `skip` (left float). Empty when the checkpoint has
     none (not from a quantisation-aware run). A convolution of the graph with no layer whose
     weights match raises, as does a layer matched twice: the ranges would be put on the wrong
     tensors."""
-    ckpt = torch.load(str(checkpoint), map_location="cpu", weights_only=False)
-    ranges = ckpt.get(qat.RANGES_KEY)
+    ranges, model = trained
     if not ranges:
         return {}
-    model = (ckpt.get("ema") or ckpt["model"]).float()
     layers = {name: folded_weight(m) for name, m in model.named_modules() if name in ranges}
     inits = {i.name: i for i in graph.initializer}
     out: dict = {}

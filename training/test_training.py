@@ -157,16 +157,17 @@ def test_qat_ranges_carried(data: Path, calib: int = 32) -> None:
     ckpt[qat.RANGES_KEY] = qat.trained_ranges(model)
     torch.save(ckpt, str(tmp / "r.pt"))
     graph = onnx.load(str(f32)).graph
-    ranges = qat_ranges.overrides(tmp / "r.pt", graph)
+    trained = qat_ranges.kept(tmp / "r.pt")
+    ranges = qat_ranges.overrides(trained, graph)
     convs = [n for n in graph.node if n.op_type == "Conv"]
     missing = [n.name for n in convs if n.input[0] not in ranges or n.output[0] not in ranges]
     assert convs and not missing, f"convolutions without ranges: {missing}"
     # A run with the head float is told from one without by its ranges alone.
-    assert not qat_ranges.trained_float_head(tmp / "r.pt")
+    assert not qat_ranges.trained_float_head(trained)
     head = YOLO(str(tmp / "m.pt")).model.float().eval()
     qat.prepare(head, qat.calibration_tensors(folder, 2), float_head=True)
     torch.save({**ckpt, qat.RANGES_KEY: qat.trained_ranges(head)}, str(tmp / "h.pt"))
-    assert qat_ranges.trained_float_head(tmp / "h.pt")
+    assert qat_ranges.trained_float_head(qat_ranges.kept(tmp / "h.pt"))
     # Calibrated on 2 images, the export would measure ranges of its own; the overrides win.
     quantise(f32, tmp / "with.onnx", folder, 2, ranges=ranges)
     quantise(f32, tmp / "without.onnx", folder, 2)
