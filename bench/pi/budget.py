@@ -123,8 +123,7 @@ def main() -> None:
     ap.add_argument("--int8", type=Path, metavar="MODEL.onnx",
                     help="count this file for the int8 stage instead of the shipped one")
     a = ap.parse_args()
-    if a.int8:
-        SETS["b_int8"] = (False, True, a.int8.resolve())
+    sets = {**SETS, "b_int8": (False, True, a.int8.resolve())} if a.int8 else SETS
     f0, f1 = (int(x) for x in a.frames.split(","))
     if not 3 <= f0 < f1:
         sys.exit("--frames: need 3 <= first < second")
@@ -137,7 +136,7 @@ def main() -> None:
               "for QEMU 7.2's plugin API version 1)")
         return
     configs = {}
-    for name, (ma, mb, model) in SETS.items():
+    for name, (ma, mb, model) in sets.items():
         configs[name] = work / f"{name}.toml"
         configs[name].write_text(CONFIG.format(a=str(ma).lower(), b=str(mb).lower(),
                                                model=f'model = "{model}"\n' if model else ""))
@@ -147,7 +146,7 @@ def main() -> None:
             binary = umbra(triple)
             if not binary.exists():
                 sys.exit(f"{binary}: build it first (.ci/run cross)")
-            for s in SETS:
+            for s in sets:
                 for n in (f0, f1):
                     out = work / f"{cpu}-{triple}-{s}-{n}.txt"
                     jobs[(board, s, n)] = pool.submit(count, qemu, cpu, board_env, so,
@@ -155,7 +154,7 @@ def main() -> None:
     per_frame = {}
     for board, *_ in BOARDS:
         steady = {s: (jobs[(board, s, f1)].result() - jobs[(board, s, f0)].result()) / (f1 - f0)
-                  for s in SETS}
+                  for s in sets}
         per_frame[board] = {
             stage: steady[s] - (steady["none"] if s != "none" else 0.0)
             for stage, s in STAGES.items()
