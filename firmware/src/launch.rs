@@ -537,6 +537,7 @@ fn load_method_b(
         mount: cfg.lidar_mount(),
         schedule,
         every: cfg.method_b.every,
+        mirror: cfg.method_b.mirror,
     }))
 }
 

@@ -25,6 +25,7 @@ use std::path::{Path, PathBuf};
 
 use models::yolo::YoloModel;
 use perception::class::ObjectClass;
+use perception::mirror_look::{FuseConfig, fuse, mirror_chw, unmirror};
 use perception::raster::{RASTER_C, RASTER_H, RASTER_LEN, RASTER_W};
 use perception::yolo::{ANCHORS, DecodeConfig, DecodeScratch, Detection, decode};
 
@@ -452,12 +453,14 @@ pub fn split_images(dataset: &Path, split: &str) -> Result<Vec<PathBuf>, String>
     Ok(v)
 }
 
-/// Runs `model` over a split and gathers the statistics by both rulers; `progress` is called
+/// Runs `model` over a split (with `mirror`, a second look at each image mirrored and fused:
+/// `perception::mirror_look`) and gathers the statistics by both rulers; `progress` is called
 /// per image.
 pub fn evaluate(
     model: &mut YoloModel,
     dataset: &Path,
     split: &str,
+    mirror: bool,
     mut progress: impl FnMut(usize, usize),
 ) -> Result<Scored, String> {
     let images = split_images(dataset, split)?;
@@ -469,6 +472,14 @@ pub fn evaluate(
     let mut wide_truth: Vec<TrueBox> = Vec::new();
     let mut scratch = DecodeScratch::new();
     let mut dets: heapless::Vec<Detection, 300> = heapless::Vec::new();
+    let mut second: heapless::Vec<Detection, 300> = heapless::Vec::new();
+    let mut fused: heapless::Vec<Detection, 300> = heapless::Vec::new();
+    let fuse_cfg = FuseConfig {
+        conf: DecodeConfig::VALIDATION.conf,
+        iou: FuseConfig::PAIR_IOU,
+        agnostic: DecodeConfig::VALIDATION.agnostic,
+        max_det: DecodeConfig::VALIDATION.max_det,
+    };
     for (n, img) in images.iter().enumerate() {
         read_png_into(img, model.input_mut())?;
         let label = dataset
@@ -477,18 +488,24 @@ pub fn evaluate(
             .join(img.file_stem().unwrap_or_default())
             .with_extension("txt");
         let truth = read_labels(&label)?;
-        model
-            .run(|out| {
-                decode(
-                    out,
-                    ANCHORS,
-                    &DecodeConfig::VALIDATION,
-                    &mut scratch,
-                    &mut dets,
-                )
-            })
-            .map_err(|e| e.to_string())?
-            .map_err(|e| e.to_string())?;
+        let cfg = if mirror {
+            DecodeConfig {
+                conf: fuse_cfg.decode_conf(),
+                ..DecodeConfig::VALIDATION
+            }
+        } else {
+            DecodeConfig::VALIDATION
+        };
+        look(model, &cfg, &mut scratch, &mut dets)?;
+        if mirror {
+            mirror_chw(model.input_mut()).map_err(|e| e.to_string())?;
+            look(model, &cfg, &mut scratch, &mut second)?;
+            for d in second.iter_mut() {
+                *d = unmirror(d);
+            }
+            fuse(&dets, &mut second, &fuse_cfg, &mut fused);
+            core::mem::swap(&mut dets, &mut fused);
+        }
         stats.ours.add_image(&truth, &dets);
         wide_truth.clear();
         wide_truth.extend(truth.iter().map(|&(c, b)| (c, study_box(b))));
@@ -498,6 +515,20 @@ pub fn evaluate(
         progress(n + 1, images.len());
     }
     Ok(stats)
+}
+
+/// One run of `model` on its current input, decoded into `dets`.
+fn look(
+    model: &mut YoloModel,
+    cfg: &DecodeConfig,
+    scratch: &mut DecodeScratch,
+    dets: &mut heapless::Vec<Detection, 300>,
+) -> Result<(), String> {
+    model
+        .run(|out| decode(out, ANCHORS, cfg, scratch, dets))
+        .map_err(|e| e.to_string())?
+        .map_err(|e| e.to_string())?;
+    Ok(())
 }
 
 /// The metrics as Ultralytics prints them.

@@ -35,8 +35,8 @@ fn evaluator_agrees_with_ultralytics() {
     };
     generate(&cfg, &dir, |_| {}).expect("dataset");
     let mut model = models::yolo::YoloModel::builtin(Default::default()).expect("model");
-    let stats =
-        lab::eval_b::evaluate(&mut model, Path::new(&dir), "test", |_, _| {}).expect("evaluation");
+    let stats = lab::eval_b::evaluate(&mut model, Path::new(&dir), "test", false, |_, _| {})
+        .expect("evaluation");
     std::fs::remove_dir_all(&dir).ok();
     let m = stats.ours.metrics();
     println!("{}", lab::eval_b::table(&m));

@@ -20,6 +20,7 @@
 //! | [`features`]   | the 9-D feature vector, in the object's frame or the map's |
 //! | [`method_a`]   | the geometric pipeline end to end, classifier as a parameter |
 //! | [`yolo`]       | Method B's output: YOLOv8 decode, suppression, map-frame centres |
+//! | [`mirror_look`] | Method B's second look at the mirrored raster; the two looks' boxes fused |
 //! | [`plausible`]  | furniture that cannot be: centres in or behind a wall seen this revolution |
 //! | [`wall_map`]   | the map's wall lines, gathered over revolutions; what lies in a wall's band |
 //! | [`map_doors`]  | doorways in the map's walls that this revolution's rays pass through |
@@ -53,6 +54,7 @@ pub mod legs;
 pub mod map_doors;
 pub mod merge;
 pub mod method_a;
+pub mod mirror_look;
 pub mod motion;
 pub mod outline;
 pub mod outline_average;

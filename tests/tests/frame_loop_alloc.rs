@@ -45,20 +45,32 @@ fn per_frame(method_b: bool) -> Vec<u64> {
 }
 
 fn per_frame_with(method_b: Option<Schedule>, viz: Option<VizLink>) -> (Vec<u64>, Summary) {
+    per_frame_sim(method_b, false, viz)
+}
+
+fn per_frame_sim(
+    method_b: Option<Schedule>,
+    mirror: bool,
+    viz: Option<VizLink>,
+) -> (Vec<u64>, Summary) {
     let cfg = Config::default();
     let source = LidarSource::sim(3, 3);
     let cal = source.sim_calibration();
     let pose = PoseInput::new(PoseState::new(cfg.pose_filter(cal), cal.is_some()));
-    per_frame_from(source, pose, method_b, viz)
+    per_frame_from(source, pose, method_b, mirror, viz)
 }
 
 fn per_frame_from(
     mut source: LidarSource,
     pose: PoseInput,
     method_b: Option<Schedule>,
+    mirror: bool,
     viz: Option<VizLink>,
 ) -> (Vec<u64>, Summary) {
-    let cfg = Config::default();
+    let mut cfg = Config::default();
+    // No frame may be degraded for time on a loaded host: a skipped stage would change the
+    // counts, and a test that depends on timing is a bug.
+    cfg.runtime.deadline_ms = 10_000.0;
     let marks = Arc::new(std::sync::Mutex::new(Vec::with_capacity(
         FRAMES as usize + 8,
     )));
@@ -69,6 +81,7 @@ fn per_frame_from(
         mount: cfg.lidar_mount(),
         schedule,
         every: 1,
+        mirror,
     });
     let mut sinks: Vec<Box<dyn FrameSink>> = vec![
         Box::new(JsonlSink(Box::new(Marks(marks.clone())))),
@@ -120,7 +133,7 @@ fn scan_matching_allocates_nothing_after_warm_up() {
     let cal = source.sim_calibration();
     let mut pose = PoseInput::new(PoseState::new(cfg.pose_filter(cal), cal.is_some()));
     pose.scan_match = Some(Box::new(ScanMatcher::new(ScanMatchConfig::default())));
-    let (d, _) = per_frame_from(source, pose, None, None);
+    let (d, _) = per_frame_from(source, pose, None, false, None);
     println!("allocations per frame, Method A and scan matching: {d:?}");
     assert!(
         d[WARM_UP..].iter().all(|&n| n == 0),
@@ -138,6 +151,23 @@ fn with_method_b_only_tract_allocates_and_a_constant_amount() {
         "per-frame count not constant: {d:?}"
     );
     assert!(steady[0] > 0, "tract allocates per run");
+}
+
+#[test]
+fn a_mirrored_second_look_allocates_only_a_second_run_of_tract() {
+    let one = per_frame(true);
+    let (two, _) = per_frame_sim(Some(Schedule::Inline), true, None);
+    println!("allocations per frame, Methods A and B with a mirrored second look: {two:?}");
+    let steady = &two[WARM_UP..];
+    assert!(
+        steady.iter().all(|&n| n == steady[0]),
+        "per-frame count not constant: {two:?}"
+    );
+    assert_eq!(
+        steady[0],
+        2 * one[WARM_UP],
+        "one look: {one:?}, two: {two:?}"
+    );
 }
 
 #[test]
@@ -229,7 +259,7 @@ fn serial_source_with_reader_threads_allocates_nothing_after_warm_up() {
     let mut pose = PoseInput::new(PoseState::new(cfg.pose_filter(None), false));
     let compass: firmware::reader::CompassReader = Box::new(|| Ok([21.5, -3.2, 40.1]));
     pose.devices = Some(firmware::reader::DeviceReader::start(None, Some(compass)).unwrap());
-    let d = per_frame_from(source, pose, None, None).0;
+    let d = per_frame_from(source, pose, None, false, None).0;
     stop.store(true, std::sync::atomic::Ordering::Relaxed);
     player.join().unwrap();
     println!("allocations per frame, serial LDS-01 + device thread, Method A: {d:?}");

@@ -74,6 +74,7 @@
 //! schedule = "auto"            # "inline" (in the frame), "worker" (its own thread); auto:
 //!                              # worker on a Pi 3 when live, else inline (docs/pi-budget.md)
 //! every = 1                    # in the frame: Method B in one frame of this many
+//! mirror = false               # a second look at the mirrored raster, fused (twice the time)
 //! ```
 
 use std::fmt;
@@ -294,6 +295,9 @@ pub struct MethodBSettings {
     pub schedule: crate::runner::Schedule,
     /// In the frame: Method B in one frame of this many (1: every frame).
     pub every: u32,
+    /// A second look at the mirrored raster, its boxes fused with the first's
+    /// (`perception::mirror_look`).
+    pub mirror: bool,
 }
 
 impl Default for MethodBSettings {
@@ -309,6 +313,7 @@ impl Default for MethodBSettings {
             threads: 1,
             schedule: crate::runner::Schedule::Auto,
             every: 1,
+            mirror: false,
         }
     }
 }

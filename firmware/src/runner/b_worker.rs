@@ -213,6 +213,7 @@ mod tests {
             mount: Pose2::new(-0.03, 0.0, 0.0),
             schedule: Schedule::Worker,
             every: 1,
+            mirror: false,
         }
     }
 

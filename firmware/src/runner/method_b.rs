@@ -7,6 +7,7 @@
 
 use perception::fusion::PlacedBox;
 use perception::geometry::Pose2;
+use perception::mirror_look::{FuseConfig, fuse, mirror_chw, unmirror};
 use perception::raster::{RasterConfig, SCAN_COLUMNS, encode_chw_f32};
 use perception::yolo::{ANCHORS, DecodeConfig, DecodeScratch, Detection, MAX_DETECTIONS, decode};
 
@@ -84,11 +85,17 @@ pub struct MethodBSetup {
     /// frame. A saving of power and CPU, not of any frame's time (the frames it runs in take
     /// as long as before).
     pub every: u32,
+    /// A second look at the mirrored raster, fused with the first
+    /// (`perception::mirror_look`): twice the network's time.
+    pub mirror: bool,
 }
 
 /// Method B's working memory, allocated once.
 pub struct MethodBScratch {
     detections: heapless::Vec<Detection, MAX_DETECTIONS>,
+    /// The mirrored look's boxes, then the fused ones (`mirror`).
+    second: heapless::Vec<Detection, MAX_DETECTIONS>,
+    fused: heapless::Vec<Detection, MAX_DETECTIONS>,
     decode: Box<DecodeScratch>,
 }
 
@@ -96,6 +103,8 @@ impl Default for MethodBScratch {
     fn default() -> Self {
         MethodBScratch {
             detections: heapless::Vec::new(),
+            second: heapless::Vec::new(),
+            fused: heapless::Vec::new(),
             decode: Box::new(DecodeScratch::new()),
         }
     }
@@ -113,15 +122,32 @@ impl MethodBSetup {
         mut place: impl FnMut(PlacedBox),
     ) -> Result<(), String> {
         encode_chw_f32(self.model.input_mut(), scans, &self.raster).map_err(|e| e.to_string())?;
-        let (dets, decode_scratch) = (&mut scratch.detections, &mut scratch.decode);
-        let cfg = &self.decode;
-        let mut decoded = None;
-        self.model.run_with(&mut |out| {
-            decoded = Some(decode(out, ANCHORS, cfg, decode_scratch, dets));
-        })?;
-        if let Some(Err(e)) = decoded {
-            return Err(e.to_string());
+        let fuse_cfg = FuseConfig {
+            conf: self.decode.conf,
+            iou: FuseConfig::PAIR_IOU,
+            agnostic: self.decode.agnostic,
+            max_det: self.decode.max_det,
+        };
+        let cfg = if self.mirror {
+            DecodeConfig {
+                conf: fuse_cfg.decode_conf(),
+                ..self.decode
+            }
+        } else {
+            self.decode
+        };
+        let s = scratch;
+        look(self.model.as_mut(), &cfg, &mut s.decode, &mut s.detections)?;
+        if self.mirror {
+            mirror_chw(self.model.input_mut()).map_err(|e| e.to_string())?;
+            look(self.model.as_mut(), &cfg, &mut s.decode, &mut s.second)?;
+            for d in s.second.iter_mut() {
+                *d = unmirror(d);
+            }
+            fuse(&s.detections, &mut s.second, &fuse_cfg, &mut s.fused);
+            core::mem::swap(&mut s.detections, &mut s.fused);
         }
+        let scratch = s;
         let lidar = middle.compose(&self.mount);
         for d in scratch.detections.iter() {
             let centre = d.centre(&lidar, &self.raster);
@@ -135,5 +161,22 @@ impl MethodBSetup {
             });
         }
         Ok(())
+    }
+}
+
+/// One run of the network on its current input, its boxes decoded into `dets`.
+fn look(
+    model: &mut (dyn Network + Send),
+    cfg: &DecodeConfig,
+    scratch: &mut DecodeScratch,
+    dets: &mut heapless::Vec<Detection, MAX_DETECTIONS>,
+) -> Result<(), String> {
+    let mut decoded = None;
+    model.run_with(&mut |out| {
+        decoded = Some(decode(out, ANCHORS, cfg, scratch, dets));
+    })?;
+    match decoded {
+        Some(Err(e)) => Err(e.to_string()),
+        _ => Ok(()),
     }
 }

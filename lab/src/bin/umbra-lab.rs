@@ -157,6 +157,10 @@ enum Command {
         /// Write the metrics here as JSON.
         #[arg(long)]
         json: Option<PathBuf>,
+        /// A second look at each image mirrored, the two looks' boxes fused (`[method_b]
+        /// mirror`, `perception::mirror_look`).
+        #[arg(long)]
+        mirror: bool,
     },
     /// Heading/position drift of odometry, compass overwrite and fusion (Markdown table).
     PoseEval {
@@ -358,13 +362,14 @@ fn run(cli: Cli) -> Result<(), String> {
             model,
             threads,
             json,
+            mirror,
         } => {
             let opts = models::yolo::YoloOptions { threads };
             let mut m = models::yolo::YoloModel::load_or_builtin(model.as_deref(), opts)
                 .map_err(|e| e.to_string())?;
             let n = lab::eval_b::split_images(&data, &split)?.len();
             let b = bar(n, "images");
-            let stats = lab::eval_b::evaluate(&mut m, &data, &split, |_, _| b.inc(1))?;
+            let stats = lab::eval_b::evaluate(&mut m, &data, &split, mirror, |_, _| b.inc(1))?;
             b.finish_and_clear();
             let report = lab::eval_b::Report {
                 ours: stats.ours.metrics(),
