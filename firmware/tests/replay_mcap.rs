@@ -45,7 +45,14 @@ fn a_recorded_run_replays_to_the_same_frames() {
     // No frame degraded for time in either run: the overrun policy's choices follow the
     // machine's speed, which a recording does not carry (`replay_models.rs`).
     let cfg = d.join("cfg.toml");
-    std::fs::write(&cfg, "[runtime]\ndeadline_ms = 10000\n").unwrap();
+    std::fs::write(
+        &cfg,
+        format!(
+            "[runtime]\ndeadline_ms = {}\n",
+            firmware::config::MAX_DEADLINE_MS
+        ),
+    )
+    .unwrap();
     let out = Command::new(env!("CARGO_BIN_EXE_umbra"))
         .args([
             "run", "--frames", "24", "--speed", "max", "--seed", "4", "--quiet",

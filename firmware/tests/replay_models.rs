@@ -42,7 +42,10 @@ fn replay(model: LidarModel, dir: &std::path::Path) -> (Vec<Value>, String) {
     let cfg = dir.join("cfg.toml");
     std::fs::write(
         &cfg,
-        "[method_b]\nenabled = false\n[runtime]\ndeadline_ms = 10000\n",
+        format!(
+            "[method_b]\nenabled = false\n[runtime]\ndeadline_ms = {}\n",
+            firmware::config::MAX_DEADLINE_MS
+        ),
     )
     .unwrap();
     let jsonl = dir.join(format!("{}.jsonl", model.cli_name()));

@@ -70,7 +70,7 @@ fn per_frame_from(
     let mut cfg = Config::default();
     // No frame may be degraded for time on a loaded host: a skipped stage would change the
     // counts, and a test that depends on timing is a bug.
-    cfg.runtime.deadline_ms = 10_000.0;
+    cfg.runtime.deadline_ms = firmware::config::MAX_DEADLINE_MS;
     let marks = Arc::new(std::sync::Mutex::new(Vec::with_capacity(
         FRAMES as usize + 8,
     )));

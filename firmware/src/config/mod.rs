@@ -129,6 +129,10 @@ impl Default for LidarSettings {
     }
 }
 
+/// The longest `[runtime] deadline_ms` accepted: no frame of a replay or a test is degraded for
+/// time under it, whatever the host's load (`docs/runtime.md`, Replay).
+pub const MAX_DEADLINE_MS: f64 = 10_000.0;
+
 /// `[runtime]`.
 #[derive(Debug, Clone, PartialEq, Deserialize)]
 #[serde(default, deny_unknown_fields)]
@@ -476,9 +480,9 @@ impl Config {
             ));
         }
         let d = self.runtime.deadline_ms;
-        if !(d.is_finite() && d > 0.0 && d <= 10_000.0) {
+        if !(d.is_finite() && d > 0.0 && d <= MAX_DEADLINE_MS) {
             return Err(format!(
-                "runtime.deadline_ms = {d}: must be within (0, 10000]"
+                "runtime.deadline_ms = {d}: must be within (0, {MAX_DEADLINE_MS}]"
             ));
         }
         let b = self.budgets();

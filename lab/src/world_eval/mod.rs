@@ -7,6 +7,7 @@
 //! world model on or off; the output lines are scored by [`score`].
 
 mod assignment;
+pub mod fates;
 pub mod picture;
 mod places;
 pub mod reliability;
@@ -100,6 +101,10 @@ pub fn generate(family: Family, seed: u64, i: usize, seconds: f64) -> GeneratedR
     }
 }
 
+/// The longest deadline `umbra` accepts (`firmware::config::MAX_DEADLINE_MS`; the lab runs
+/// the binary and does not link it): under it no replayed frame is degraded for time.
+const MAX_DEADLINE_MS: u32 = 10_000;
+
 /// Writes `run` to `dir` and replays it through `umbra` with the world model `world`.
 pub fn replay(
     umbra: &Path,
@@ -119,7 +124,7 @@ pub fn replay(
     let config = write(
         if world { "world-on.toml" } else { "world-off.toml" },
         format!(
-            "# eval-world: no frame is skipped for time on a loaded host\n[runtime]\ndeadline_ms = 10000\n[world]\nenabled = {world}\n{}",
+            "# eval-world: no frame is skipped for time on a loaded host\n[runtime]\ndeadline_ms = {MAX_DEADLINE_MS}\n[world]\nenabled = {world}\n{}",
             if world {
                 world_set.iter().map(|l| format!("{l}\n")).collect::<String>()
             } else {
@@ -288,6 +293,14 @@ pub fn report(outcomes: &[Outcome]) -> String {
                 t.map_tp[c],
                 t.map_visible[c],
                 t.map_reported[c]
+            );
+        }
+        for (k, fate) in fates::FATES.iter().enumerate().skip(1) {
+            let n = t.fates.map(|c| c[k]);
+            let _ = writeln!(
+                s,
+                "    missed: {fate:40} chair {:3}  box {:3}  desk {:3}",
+                n[0], n[1], n[2]
             );
         }
         let _ = writeln!(

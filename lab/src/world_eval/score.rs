@@ -208,6 +208,10 @@ pub struct Tally {
     /// ([`reliability::reliability_index`]); empty until a detection was scored.
     #[serde(default)]
     pub reliability: Vec<u32>,
+    /// What became of each piece the final map is scored on, per class (chair, box, desk) and
+    /// fate (`fates::FATES` order): found, or why not.
+    #[serde(default)]
+    pub fates: [[u32; 5]; 3],
     /// The reports on walking people, one line each (frame, id, class, source), for reading.
     #[serde(skip)]
     pub people_reports: Vec<String>,
@@ -468,6 +472,7 @@ pub fn score_run(truth: &RunTruth, lines: &[Line], tally: &mut Tally) {
         }
         if let Some(ci) = class_index(f.class) {
             tally.map_visible[ci] += 1;
+            tally.fates[ci][super::fates::fate(truth, lines, f, taken[g]).index()] += 1;
         }
         let split = if f.against_wall {
             &mut tally.wall_found
@@ -568,6 +573,14 @@ impl Tally {
             self.reliability.resize(o.reliability.len(), 0);
         }
         for (a, b) in self.reliability.iter_mut().zip(&o.reliability) {
+            *a += b;
+        }
+        for (a, b) in self
+            .fates
+            .iter_mut()
+            .flatten()
+            .zip(o.fates.iter().flatten())
+        {
             *a += b;
         }
     }
@@ -905,7 +918,12 @@ mod test {
                         serde_json::Value::Array(a) if a.is_empty() => {
                             *v = vec![serde_json::Value::from(x)].into()
                         }
-                        serde_json::Value::Array(a) => a.iter_mut().for_each(|e| *e = x.into()),
+                        serde_json::Value::Array(a) => a.iter_mut().for_each(|e| match e {
+                            serde_json::Value::Array(row) => {
+                                row.iter_mut().for_each(|e| *e = x.into())
+                            }
+                            _ => *e = x.into(),
+                        }),
                         _ => {}
                     }
                 }
