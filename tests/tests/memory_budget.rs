@@ -274,6 +274,11 @@ fn buffers_in_code() -> Vec<(&'static str, usize, usize)> {
             size_of::<perception::yolo::DecodeScratch>(),
         ),
         (
+            "size_of::<firmware::runner::MethodBScratch>()",
+            1,
+            size_of::<firmware::runner::MethodBScratch>(),
+        ),
+        (
             "perception::yolo::MAX_DETECTIONS",
             perception::yolo::MAX_DETECTIONS,
             size_of::<perception::yolo::Detection>(),

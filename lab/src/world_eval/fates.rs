@@ -79,6 +79,13 @@ pub fn fate(truth: &RunTruth, lines: &[Line], piece: &Furniture, found: bool) ->
     }
 }
 
+/// Sums a tally's fates (class × fate) into another's.
+pub fn add(into: &mut [[u32; 5]; 3], from: &[[u32; 5]; 3]) {
+    for (a, b) in into.iter_mut().flatten().zip(from.iter().flatten()) {
+        *a += b;
+    }
+}
+
 #[cfg(test)]
 mod test {
     use super::*;

@@ -208,8 +208,7 @@ pub struct Tally {
     /// ([`reliability::reliability_index`]); empty until a detection was scored.
     #[serde(default)]
     pub reliability: Vec<u32>,
-    /// What became of each piece the final map is scored on, per class (chair, box, desk) and
-    /// fate (`fates::FATES` order): found, or why not.
+    /// Pieces the final map is scored on by class (chair, box, desk) and `fates::FATES`.
     #[serde(default)]
     pub fates: [[u32; 5]; 3],
     /// The reports on walking people, one line each (frame, id, class, source), for reading.
@@ -575,14 +574,7 @@ impl Tally {
         for (a, b) in self.reliability.iter_mut().zip(&o.reliability) {
             *a += b;
         }
-        for (a, b) in self
-            .fates
-            .iter_mut()
-            .flatten()
-            .zip(o.fates.iter().flatten())
-        {
-            *a += b;
-        }
+        super::fates::add(&mut self.fates, &o.fates);
     }
 
     /// IDF1 = 2·IDTP / (GT + reported).
