@@ -1,7 +1,9 @@
 //! What became of each piece of furniture the final map is scored on (visible, there at the
 //! end): found, or why not. A miss is the world model's when the methods found the piece and
-//! the map dropped it or never confirmed it, and the detectors' when they did not find it or
-//! found it but seldom as its class. The split says which side of umbra the next change belongs to.
+//! the map dropped it, gave it the wrong class or never confirmed it, and the detectors' when
+//! they did not find it or found it but seldom as its class. The split says which side of umbra the next change belongs to.
+
+use perception::class::ObjectClass;
 
 use super::score::{Line, MATCH_M};
 use crate::run_truth::{Furniture, RunTruth};
@@ -13,6 +15,9 @@ pub enum Fate {
     Found,
     /// An object of its class on it in some line, not the last.
     Dropped,
+    /// Never reported as its class, but as another furniture class (an object of that class on
+    /// it in some line).
+    ReportedOther,
     /// Never reported, though detected as its class at least [`DETECTED_MIN`] times.
     NeverReported,
     /// Detected at least [`DETECTED_MIN`] times, but as its class fewer times than that: taken
@@ -22,10 +27,14 @@ pub enum Fate {
     Undetected,
 }
 
+/// How many fates there are.
+pub const FATE_COUNT: usize = 6;
+
 /// The fates' names, as the report prints them.
-pub const FATES: [&str; 5] = [
+pub const FATES: [&str; FATE_COUNT] = [
     "found",
     "reported for a while, not at the end",
+    "reported, but only as another class",
     "detected as its class, never reported",
     "detected, as its class under 10 times",
     "not detected",
@@ -51,16 +60,22 @@ pub fn fate(truth: &RunTruth, lines: &[Line], piece: &Furniture, found: bool) ->
     if found {
         return Fate::Found;
     }
-    let mut reported = false;
+    let (mut reported, mut as_other) = (false, false);
     let (mut own, mut all) = (0u32, 0u32);
     for line in lines {
         if !truth.frame_at(line.t).is_some_and(|fi| piece.alive(fi)) {
             continue;
         }
-        reported |= line
+        for o in line
             .objects
             .iter()
-            .any(|o| o.class == Some(piece.class) && piece.distance(o.at) <= MATCH_M);
+            .filter(|o| piece.distance(o.at) <= MATCH_M)
+        {
+            reported |= o.class == Some(piece.class);
+            as_other |= o
+                .class
+                .is_some_and(|c| c != piece.class && c != ObjectClass::DoorFrame);
+        }
         for d in line.detections.as_deref().unwrap_or(&line.objects) {
             if d.class.is_some() && piece.distance(d.at) <= NEAR_M {
                 all += 1;
@@ -70,6 +85,8 @@ pub fn fate(truth: &RunTruth, lines: &[Line], piece: &Furniture, found: bool) ->
     }
     if reported {
         Fate::Dropped
+    } else if as_other {
+        Fate::ReportedOther
     } else if own >= DETECTED_MIN {
         Fate::NeverReported
     } else if all >= DETECTED_MIN {
@@ -80,7 +97,7 @@ pub fn fate(truth: &RunTruth, lines: &[Line], piece: &Furniture, found: bool) ->
 }
 
 /// Sums a tally's fates (class × fate) into another's.
-pub fn add(into: &mut [[u32; 5]; 3], from: &[[u32; 5]; 3]) {
+pub fn add(into: &mut [[u32; FATE_COUNT]; 3], from: &[[u32; FATE_COUNT]; 3]) {
     for (a, b) in into.iter_mut().flatten().zip(from.iter().flatten()) {
         *a += b;
     }
@@ -90,7 +107,6 @@ pub fn add(into: &mut [[u32; 5]; 3], from: &[[u32; 5]; 3]) {
 mod test {
     use super::*;
     use crate::world_eval::score::Reported;
-    use perception::class::ObjectClass;
     use perception::geometry::Point2;
 
     fn piece() -> Furniture {
@@ -153,8 +169,10 @@ mod test {
         let mut lines: Vec<Line> = (0..20).map(|i| line(i, vec![], vec![])).collect();
         lines[3].objects.push(chair(0.2));
         assert_eq!(fate(&t, &lines, &p, false), Fate::Dropped);
-        // A report of another class, or 0.35 m off, is not its report.
+        // A report of another class is a report as another class; 0.35 m off, no report.
         lines[3].objects = vec![desk(0.2), chair(0.75)];
+        assert_eq!(fate(&t, &lines, &p, false), Fate::ReportedOther);
+        lines[3].objects = vec![chair(0.75), rep(ObjectClass::DoorFrame, 0.2)];
         assert_eq!(fate(&t, &lines, &p, false), Fate::Undetected);
         // Ten detections of its class within 0.5 m (0.45 m off the footprint counts).
         for l in lines.iter_mut().take(10) {

@@ -210,7 +210,7 @@ pub struct Tally {
     pub reliability: Vec<u32>,
     /// Pieces the final map is scored on by class (chair, box, desk) and `fates::FATES`.
     #[serde(default)]
-    pub fates: [[u32; 5]; 3],
+    pub fates: [[u32; super::fates::FATE_COUNT]; 3],
     /// The reports on walking people, one line each (frame, id, class, source), for reading.
     #[serde(skip)]
     pub people_reports: Vec<String>,
