@@ -25,7 +25,7 @@ use std::path::{Path, PathBuf};
 
 use models::yolo::YoloModel;
 use perception::class::ObjectClass;
-use perception::mirror_look::{FuseConfig, fuse, mirror_chw, unmirror};
+use perception::mirror_look::{FuseConfig, fuse_second_look, mirror_chw};
 use perception::raster::{RASTER_C, RASTER_H, RASTER_LEN, RASTER_W};
 use perception::yolo::{ANCHORS, DecodeConfig, DecodeScratch, Detection, decode};
 
@@ -474,11 +474,11 @@ pub fn evaluate(
     let mut dets: heapless::Vec<Detection, 300> = heapless::Vec::new();
     let mut second: heapless::Vec<Detection, 300> = heapless::Vec::new();
     let mut fused: heapless::Vec<Detection, 300> = heapless::Vec::new();
-    let fuse_cfg = FuseConfig {
-        conf: DecodeConfig::VALIDATION.conf,
-        iou: FuseConfig::PAIR_IOU,
-        agnostic: DecodeConfig::VALIDATION.agnostic,
-        max_det: DecodeConfig::VALIDATION.max_det,
+    let fuse_cfg = FuseConfig::of(&DecodeConfig::VALIDATION);
+    let cfg = if mirror {
+        fuse_cfg.look_decode(&DecodeConfig::VALIDATION)
+    } else {
+        DecodeConfig::VALIDATION
     };
     for (n, img) in images.iter().enumerate() {
         read_png_into(img, model.input_mut())?;
@@ -488,23 +488,11 @@ pub fn evaluate(
             .join(img.file_stem().unwrap_or_default())
             .with_extension("txt");
         let truth = read_labels(&label)?;
-        let cfg = if mirror {
-            DecodeConfig {
-                conf: fuse_cfg.decode_conf(),
-                ..DecodeConfig::VALIDATION
-            }
-        } else {
-            DecodeConfig::VALIDATION
-        };
         look(model, &cfg, &mut scratch, &mut dets)?;
         if mirror {
             mirror_chw(model.input_mut()).map_err(|e| e.to_string())?;
             look(model, &cfg, &mut scratch, &mut second)?;
-            for d in second.iter_mut() {
-                *d = unmirror(d);
-            }
-            fuse(&dets, &mut second, &fuse_cfg, &mut fused);
-            core::mem::swap(&mut dets, &mut fused);
+            fuse_second_look(&mut dets, &mut second, &fuse_cfg, &mut fused);
         }
         stats.ours.add_image(&truth, &dets);
         wide_truth.clear();

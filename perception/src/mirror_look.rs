@@ -15,14 +15,15 @@
 //! one look alone keeps half its score: the other look scored it below the threshold it was
 //! decoded at, taken as 0. With `agnostic`, a pair whose classes differ keeps the surer look's
 //! class at half its score. So both looks must be decoded at half the score the fused boxes
-//! must reach ([`FuseConfig::decode_conf`]).
+//! must reach ([`FuseConfig::look_decode`]). [`fuse_second_look`] is the whole step after the two
+//! runs, for every caller (the runtime's frame, the image evaluator).
 //!
 //! Everything works in place or in caller-owned buffers: no allocation, no panic.
 
 use heapless::Vec;
 
 use crate::raster::{RASTER_H, RASTER_LEN, RASTER_W, SCAN_COLUMNS};
-use crate::yolo::{Detection, iou};
+use crate::yolo::{DecodeConfig, Detection, iou};
 
 /// A raster input that is not `3 × 64 × 384` floats.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -81,11 +82,41 @@ impl FuseConfig {
     /// The weighted-boxes-fusion papers' pairing IoU (0.55).
     pub const PAIR_IOU: f32 = 0.55;
 
-    /// The score each look must be decoded at: half of [`FuseConfig::conf`], so that a pair of
-    /// boxes whose mean passes `conf` is not lost because one of the two was below it.
-    pub fn decode_conf(&self) -> f32 {
-        self.conf * 0.5
+    /// The fusion that keeps what `decode` would keep of one look: its score threshold, its
+    /// class-agnosticism, its number of boxes.
+    pub fn of(decode: &DecodeConfig) -> FuseConfig {
+        FuseConfig {
+            conf: decode.conf,
+            iou: Self::PAIR_IOU,
+            agnostic: decode.agnostic,
+            max_det: decode.max_det,
+        }
     }
+
+    /// How each look is decoded: as `decode`, at half of [`FuseConfig::conf`], so that a pair
+    /// of boxes whose mean passes `conf` is not lost because one of the two was below it.
+    pub fn look_decode(&self, decode: &DecodeConfig) -> DecodeConfig {
+        DecodeConfig {
+            conf: self.conf * 0.5,
+            ..*decode
+        }
+    }
+}
+
+/// The step after both runs: `second` (the mirrored look's boxes) is mirrored back and fused
+/// with `first` ([`fuse`]), and `first` then holds the fused boxes (`fused` is scratch).
+pub fn fuse_second_look<const N: usize>(
+    first: &mut Vec<Detection, N>,
+    second: &mut Vec<Detection, N>,
+    cfg: &FuseConfig,
+    fused: &mut Vec<Detection, N>,
+) -> FuseStats {
+    for d in second.iter_mut() {
+        *d = unmirror(d);
+    }
+    let stats = fuse(first, second, cfg, fused);
+    core::mem::swap(first, fused);
+    stats
 }
 
 /// What [`fuse`] did.
@@ -287,6 +318,25 @@ mod test {
         assert!((out[0].w - 10.0).abs() < 1e-4);
         assert_eq!(out[1].class, ObjectClass::Box);
         assert!((out[1].score - 0.35).abs() < 1e-6);
+    }
+
+    #[test]
+    fn a_second_look_is_mirrored_back_before_it_is_fused() {
+        let cfg = FuseConfig::of(&DecodeConfig::RUNTIME);
+        assert_eq!((cfg.conf, cfg.max_det), (0.25, 32));
+        assert_eq!(cfg.look_decode(&DecodeConfig::RUNTIME).conf, 0.125);
+        let mut first: Vec<Detection, 4> = Vec::new();
+        let mut second: Vec<Detection, 4> = Vec::new();
+        let mut fused: Vec<Detection, 4> = Vec::new();
+        first.push(det(ObjectClass::Box, 0.6, 15.0, 10.0)).unwrap();
+        // The same box, found at columns 340..350 of the mirrored raster.
+        second
+            .push(det(ObjectClass::Box, 0.4, 345.0, 10.0))
+            .unwrap();
+        let s = fuse_second_look(&mut first, &mut second, &cfg, &mut fused);
+        assert_eq!(s.paired, 1);
+        assert_eq!(first.len(), 1);
+        assert!((first[0].score - 0.5).abs() < 1e-6 && (first[0].cx - 15.0).abs() < 1e-4);
     }
 
     #[test]

@@ -7,7 +7,7 @@
 
 use perception::fusion::PlacedBox;
 use perception::geometry::Pose2;
-use perception::mirror_look::{FuseConfig, fuse, mirror_chw, unmirror};
+use perception::mirror_look::{FuseConfig, fuse_second_look, mirror_chw};
 use perception::raster::{RasterConfig, SCAN_COLUMNS, encode_chw_f32};
 use perception::yolo::{ANCHORS, DecodeConfig, DecodeScratch, Detection, MAX_DETECTIONS, decode};
 
@@ -122,32 +122,29 @@ impl MethodBSetup {
         mut place: impl FnMut(PlacedBox),
     ) -> Result<(), String> {
         encode_chw_f32(self.model.input_mut(), scans, &self.raster).map_err(|e| e.to_string())?;
-        let fuse_cfg = FuseConfig {
-            conf: self.decode.conf,
-            iou: FuseConfig::PAIR_IOU,
-            agnostic: self.decode.agnostic,
-            max_det: self.decode.max_det,
-        };
+        let fuse_cfg = FuseConfig::of(&self.decode);
         let cfg = if self.mirror {
-            DecodeConfig {
-                conf: fuse_cfg.decode_conf(),
-                ..self.decode
-            }
+            fuse_cfg.look_decode(&self.decode)
         } else {
             self.decode
         };
-        let s = scratch;
-        look(self.model.as_mut(), &cfg, &mut s.decode, &mut s.detections)?;
+        look(
+            self.model.as_mut(),
+            &cfg,
+            &mut scratch.decode,
+            &mut scratch.detections,
+        )?;
         if self.mirror {
             mirror_chw(self.model.input_mut()).map_err(|e| e.to_string())?;
-            look(self.model.as_mut(), &cfg, &mut s.decode, &mut s.second)?;
-            for d in s.second.iter_mut() {
-                *d = unmirror(d);
-            }
-            fuse(&s.detections, &mut s.second, &fuse_cfg, &mut s.fused);
-            core::mem::swap(&mut s.detections, &mut s.fused);
+            look(
+                self.model.as_mut(),
+                &cfg,
+                &mut scratch.decode,
+                &mut scratch.second,
+            )?;
+            let s = &mut *scratch;
+            fuse_second_look(&mut s.detections, &mut s.second, &fuse_cfg, &mut s.fused);
         }
-        let scratch = s;
         let lidar = middle.compose(&self.mount);
         for d in scratch.detections.iter() {
             let centre = d.centre(&lidar, &self.raster);

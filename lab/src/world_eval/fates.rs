@@ -1,7 +1,8 @@
 //! What became of each piece of furniture the final map is scored on (visible, there at the
 //! end): found, or why not. A miss is the world model's when the methods found the piece and
 //! the map dropped it, gave it the wrong class or never confirmed it, and the detectors' when
-//! they did not find it or found it but seldom as its class. The split says which side of umbra the next change belongs to.
+//! they did not find it or found it but seldom as its class. The split says which side of
+//! umbra the next change belongs to.
 
 use perception::class::ObjectClass;
 
