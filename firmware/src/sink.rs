@@ -71,6 +71,11 @@ pub trait FrameSink {
     fn records_input(&self) -> bool {
         false
     }
+    /// Called between frames, outside the frame's time, only when the source does not pace
+    /// itself (`--speed max`, a file): waits until the sink can take the next frame without
+    /// dropping it. Nothing is lost by waiting for a simulation or a file, so such a run's
+    /// recording is complete; a real sensor's run never waits here.
+    fn make_room(&mut self) {}
 }
 
 /// One JSON line a frame (`--jsonl PATH|-`).

@@ -18,8 +18,10 @@
 //!
 //! The frame loop never allocates for this: it fills a [`VizFrame`] taken from a pool of
 //! boxes made at start-up and hands it to the viz thread through a bounded channel; the thread
-//! converts, logs and returns the box. When the thread falls behind, frames are dropped and
-//! counted ([`VizLink::dropped`]), never queued without bound.
+//! converts, logs and returns the box. When the thread falls behind a real sensor, frames are
+//! dropped and counted ([`VizLink::dropped`]), never queued without bound; when the source
+//! does not pace itself (`--speed max`, a file) the loop waits between frames for a free box
+//! instead ([`VizLink::wait_for_room`]), so that run's recording is complete.
 
 use std::net::SocketAddr;
 use std::path::PathBuf;
@@ -118,6 +120,8 @@ pub struct VizLink {
     to_thread: Option<SyncSender<Box<VizFrame>>>,
     pool: Receiver<Box<VizFrame>>,
     thread: Option<JoinHandle<Result<(), String>>>,
+    /// A free box taken by [`VizLink::wait_for_room`], used by the next [`VizLink::send`].
+    spare: Option<Box<VizFrame>>,
     dropped: u64,
     sent: u64,
     live_port: Option<u16>,
@@ -187,6 +191,7 @@ impl VizLink {
             to_thread: Some(to_thread),
             pool,
             thread: Some(thread),
+            spare: None,
             dropped: 0,
             sent: 0,
             live_port,
@@ -202,7 +207,7 @@ impl VizLink {
     /// box (the thread is behind) the frame is dropped and counted, and `false` returned (the
     /// caller keeps its raw bytes for the next frame). Allocates nothing.
     pub fn send(&mut self, fill: impl FnOnce(&mut VizFrame)) -> bool {
-        let Ok(mut frame) = self.pool.try_recv() else {
+        let Some(mut frame) = self.spare.take().or_else(|| self.pool.try_recv().ok()) else {
             self.dropped += 1;
             return false;
         };
@@ -216,6 +221,15 @@ impl VizLink {
                 self.dropped += 1;
                 false
             }
+        }
+    }
+
+    /// Blocks until a box is free (the viz thread has caught up by one frame), so the next
+    /// [`VizLink::send`] cannot drop. Returns at once when a box is already held or the thread
+    /// has ended (its end of the pool is gone). Allocates nothing.
+    pub fn wait_for_room(&mut self) {
+        if self.spare.is_none() {
+            self.spare = self.pool.recv().ok();
         }
     }
 
@@ -294,6 +308,11 @@ impl FrameSink for VizSink {
     }
     fn dropped(&self) -> u64 {
         self.0.as_ref().map_or(0, VizLink::dropped)
+    }
+    fn make_room(&mut self) {
+        if let Some(link) = self.0.as_mut() {
+            link.wait_for_room();
+        }
     }
     fn records_input(&self) -> bool {
         self.0.is_some()

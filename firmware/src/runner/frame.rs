@@ -30,6 +30,7 @@ use crate::output::{
 };
 use crate::record_format::RECORD_RAW_BYTES;
 use crate::sink::FrameView;
+use crate::source::Pacing;
 use drivers::lidar::RevolutionStream;
 
 /// A Method B door frame this close to a door of Method A's is that door, m.
@@ -286,6 +287,12 @@ impl<S: RevolutionStream> FrameLoop<'_, S> {
         let Some(rev) = stream.last_revolution() else {
             return Ok(false);
         };
+        if opts.pacing == Pacing::Max {
+            // Nothing paces the source: the sinks catch up before the frame's clock starts.
+            for sink in opts.sinks.iter_mut() {
+                sink.make_room();
+            }
+        }
         let t_frame = Instant::now();
         let frame = summary.frames;
         let valid = rev.valid_count() as u32;
