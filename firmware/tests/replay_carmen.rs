@@ -57,9 +57,14 @@ fn replay(log: &Path, frames: Option<usize>) -> (Vec<serde_json::Value>, String)
     // matching off: what is checked is that the log's poses come through the wheel-tick pose
     // filter; the matcher on these logs is `tests/tests/real_scan_match.rs`'s.
     let cfg = dir.join("cfg.toml");
+    // The deadline at its most: a frame the loaded test machine makes slow is not degraded, so
+    // the run does not depend on the machine's speed (the time per frame is the benches' job).
     std::fs::write(
         &cfg,
-        "[method_b]\nenabled = false\n[pose]\nscan_match = false\n",
+        format!(
+            "[method_b]\nenabled = false\n[pose]\nscan_match = false\n[runtime]\ndeadline_ms = {}\n",
+            firmware::config::MAX_DEADLINE_MS
+        ),
     )
     .unwrap();
     let out_path = dir.join("out.jsonl");
