@@ -538,6 +538,7 @@ fn load_method_b(
         schedule,
         every: cfg.method_b.every,
         mirror: cfg.method_b.mirror,
+        seam: cfg.method_b.seam,
     }))
 }
 

@@ -11,6 +11,7 @@
 //! | [`pose`]       | wheel odometry, hard-iron fit, compass/odometry heading filter |
 //! | [`scan_match`] | each revolution laid on a keyframe's (point-to-line ICP): a pose that does not drift |
 //! | [`raster`]     | three revolutions as the 64 × 384 × 3 image of Method B (bit-exact spec) |
+//! | [`seam`]       | where the raster starts: its edges on a plain wall, not through furniture |
 //! | [`cloud`]      | Method A's global point cloud: a fixed ring with aging |
 //! | [`dbscan`]     | adaptive-ε DBSCAN, grid-indexed and allocation-free |
 //! | [`shape`]      | centroid, principal-axes and minimum-area boxes of point sets |
@@ -62,6 +63,7 @@ pub mod plausible;
 pub mod pose;
 pub mod raster;
 pub mod scan_match;
+pub mod seam;
 pub mod shape;
 pub mod sight;
 pub mod still_legs;

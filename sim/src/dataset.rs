@@ -29,6 +29,7 @@ use std::time::Instant;
 use perception::class::ObjectClass;
 use perception::geometry::{Point2, Pose2};
 use perception::raster::{RASTER_H, RASTER_LEN, RASTER_W, RasterConfig, encode_hwc};
+use perception::seam::{Rolled, SeamRule};
 use rand::SeedableRng;
 use rand::seq::SliceRandom;
 use rand_chacha::ChaCha8Rng;
@@ -67,6 +68,8 @@ pub struct DatasetConfig {
     pub test_only: bool,
     /// People walking through each scenario: 0 to this many (`crate::people`), never labelled.
     pub people: usize,
+    /// Where each image starts (`perception::seam`); its labels follow.
+    pub seam: SeamRule,
 }
 
 impl Default for DatasetConfig {
@@ -83,6 +86,7 @@ impl Default for DatasetConfig {
             pictures: 3,
             test_only: false,
             people: 0,
+            seam: SeamRule::Fixed,
         }
     }
 }
@@ -199,9 +203,16 @@ pub fn simulate(
         let (t, t1, t2) = (slot, (slot + 2) % 3, (slot + 1) % 3);
         // The raster cannot fail: the buffer has the right length and the config is checked
         // by the caller (`generate`); an error here would only skip the sample.
+        let seam = cfg
+            .seam
+            .seam([&ranges[t], &ranges[t1], &ranges[t2]], &cfg.raster);
+        let rolled = |k: usize| Rolled {
+            scan: &ranges[k],
+            seam,
+        };
         if encode_hwc(
             &mut raster,
-            [&ranges[t], &ranges[t1], &ranges[t2]],
+            [&rolled(t), &rolled(t1), &rolled(t2)],
             &cfg.raster,
         )
         .is_err()
@@ -213,6 +224,7 @@ pub fn simulate(
             &scenario.world,
             [&ring[t], &ring[t1], &ring[t2]],
             &cfg.raster,
+            seam,
             &mut boxes,
         );
         on_sample(
@@ -653,6 +665,62 @@ mod test {
             );
         }
         assert!(per_class.iter().all(|&n| n > 0), "{per_class:?}");
+    }
+
+    /// Boxes touching the image's left or right edge (cut by the seam), boxes with no drawn
+    /// pixel inside, and all boxes, over a few scenarios drawn with `seam`.
+    fn seam_counts(seam: SeamRule) -> (usize, usize, usize) {
+        let cfg = DatasetConfig {
+            scenarios: 8,
+            frames: 10,
+            seed: 5,
+            seam,
+            ..DatasetConfig::default()
+        };
+        let (mut cut, mut empty, mut all) = (0, 0, 0);
+        for i in 0..cfg.scenarios {
+            simulate(
+                i,
+                &cfg,
+                |_, _, _| {},
+                |_, s| {
+                    for b in s.boxes {
+                        all += 1;
+                        let (c0, c1) = (b.cx - b.w / 2.0, b.cx + b.w / 2.0);
+                        if c0 <= 0.5 || c1 >= 359.5 {
+                            cut += 1;
+                        }
+                        let (r0, r1) = (b.cy - b.h / 2.0, b.cy + b.h / 2.0);
+                        let drawn = (r0 as usize..(r1.ceil() as usize).min(RASTER_H)).any(|r| {
+                            (c0 as usize..(c1.ceil() as usize).min(RASTER_W))
+                                .any(|c| s.raster[(r * RASTER_W + c) * 3..][..3] != [0, 0, 0])
+                        });
+                        if !drawn {
+                            empty += 1;
+                        }
+                    }
+                },
+            );
+        }
+        (cut, empty, all)
+    }
+
+    #[test]
+    fn the_quiet_seam_cuts_fewer_boxes_and_its_labels_follow_the_image() {
+        let (fixed_cut, fixed_empty, fixed_all) = seam_counts(SeamRule::Fixed);
+        let (quiet_cut, quiet_empty, quiet_all) = seam_counts(SeamRule::Quiet);
+        println!(
+            "boxes on the seam: fixed {fixed_cut} of {fixed_all}, quiet {quiet_cut} of {quiet_all}; \
+             with nothing drawn inside: {fixed_empty}, {quiet_empty}"
+        );
+        // The same objects are labelled; only where the image starts differs.
+        assert_eq!(fixed_all, quiet_all);
+        assert!(fixed_cut > 0, "the fixed seam cuts some boxes");
+        assert!(2 * quiet_cut < fixed_cut, "{quiet_cut} vs {fixed_cut}");
+        // Every object returned readings, so its box holds pixels: a box beside its
+        // object (labels turned one way, the image the other) would not.
+        assert_eq!(fixed_empty, 0);
+        assert_eq!(quiet_empty, 0);
     }
 
     #[test]

@@ -3,7 +3,7 @@
 //! **Method B boxes** ([`yolo_boxes`]): for a raster of revolutions t, t−1, t−2, each object
 //! (furniture or door frame) that returned at least [`MIN_RETURNS`] readings in those three
 //! revolutions gets a box computed from its footprint in the LiDAR's pose at the middle of
-//! revolution t−1:
+//! revolution t−1, turned to the image's first column (`perception::seam`):
 //!
 //! * columns: the smallest arc of bearings (degrees counter-clockwise, our raster's column
 //!   convention) containing the footprint's corners, padded by [`PAD_COLS`] each side. An arc
@@ -19,6 +19,7 @@
 use perception::class::ObjectClass;
 use perception::geometry::{Point2, Pose2};
 use perception::raster::{RASTER_H, RASTER_W, RasterConfig, SCAN_COLUMNS, row_for_range};
+use perception::seam::turned;
 
 use crate::lds01::LIDAR_MOUNT;
 use crate::scenario::Frame;
@@ -138,9 +139,16 @@ pub fn footprint_box(
     })
 }
 
-/// Boxes for the raster of `frames` = [t, t−1, t−2], appended to `out`.
-pub fn yolo_boxes(world: &World, frames: [&Frame; 3], cfg: &RasterConfig, out: &mut Vec<PixelBox>) {
-    let lidar = frames[1].pose_mid.compose(&LIDAR_MOUNT);
+/// Boxes for the raster of `frames` = [t, t−1, t−2] drawn from bin `seam` on
+/// (`perception::seam`: column `c` is bearing `c + seam`), appended to `out`.
+pub fn yolo_boxes(
+    world: &World,
+    frames: [&Frame; 3],
+    cfg: &RasterConfig,
+    seam: usize,
+    out: &mut Vec<PixelBox>,
+) {
+    let lidar = turned(&frames[1].pose_mid.compose(&LIDAR_MOUNT), seam);
     for (n, o) in world.objects.iter().enumerate() {
         if returns_of(frames, Surface::Object(n as u16)) >= MIN_RETURNS
             && let Some(b) = footprint_box(o.class, &o.footprint, &lidar, cfg)

@@ -10,7 +10,7 @@ use std::sync::atomic::AtomicBool;
 use firmware::config::Config;
 use firmware::odom::{PoseInput, PoseState};
 use firmware::power::PowerMeter;
-use firmware::runner::{self, MethodBSetup, RunOptions, Schedule, SecondsClock, Summary};
+use firmware::runner::{self, MethodBSetup, RunOptions, Schedule, Seam, SecondsClock, Summary};
 use firmware::sink::{FrameSink, JsonlSink, SceneSink, StatsSink};
 use firmware::source::{LidarSource, Pacing};
 use firmware::viz::{VizLink, VizSink};
@@ -45,19 +45,20 @@ fn per_frame(method_b: bool) -> Vec<u64> {
 }
 
 fn per_frame_with(method_b: Option<Schedule>, viz: Option<VizLink>) -> (Vec<u64>, Summary) {
-    per_frame_sim(method_b, false, viz)
+    per_frame_sim(method_b, false, Seam::Fixed, viz)
 }
 
 fn per_frame_sim(
     method_b: Option<Schedule>,
     mirror: bool,
+    seam: Seam,
     viz: Option<VizLink>,
 ) -> (Vec<u64>, Summary) {
     let cfg = Config::default();
     let source = LidarSource::sim(3, 3);
     let cal = source.sim_calibration();
     let pose = PoseInput::new(PoseState::new(cfg.pose_filter(cal), cal.is_some()));
-    per_frame_from(source, pose, method_b, mirror, viz)
+    per_frame_from(source, pose, method_b, mirror, seam, viz)
 }
 
 fn per_frame_from(
@@ -65,6 +66,7 @@ fn per_frame_from(
     pose: PoseInput,
     method_b: Option<Schedule>,
     mirror: bool,
+    seam: Seam,
     viz: Option<VizLink>,
 ) -> (Vec<u64>, Summary) {
     let mut cfg = Config::default();
@@ -82,6 +84,7 @@ fn per_frame_from(
         schedule,
         every: 1,
         mirror,
+        seam,
     });
     let mut sinks: Vec<Box<dyn FrameSink>> = vec![
         Box::new(JsonlSink(Box::new(Marks(marks.clone())))),
@@ -133,7 +136,7 @@ fn scan_matching_allocates_nothing_after_warm_up() {
     let cal = source.sim_calibration();
     let mut pose = PoseInput::new(PoseState::new(cfg.pose_filter(cal), cal.is_some()));
     pose.scan_match = Some(Box::new(ScanMatcher::new(ScanMatchConfig::default())));
-    let (d, _) = per_frame_from(source, pose, None, false, None);
+    let (d, _) = per_frame_from(source, pose, None, false, Seam::Fixed, None);
     println!("allocations per frame, Method A and scan matching: {d:?}");
     assert!(
         d[WARM_UP..].iter().all(|&n| n == 0),
@@ -156,7 +159,7 @@ fn with_method_b_only_tract_allocates_and_a_constant_amount() {
 #[test]
 fn a_mirrored_second_look_allocates_only_a_second_run_of_tract() {
     let one = per_frame(true);
-    let (two, _) = per_frame_sim(Some(Schedule::Inline), true, None);
+    let (two, _) = per_frame_sim(Some(Schedule::Inline), true, Seam::Fixed, None);
     println!("allocations per frame, Methods A and B with a mirrored second look: {two:?}");
     let steady = &two[WARM_UP..];
     assert!(
@@ -167,6 +170,18 @@ fn a_mirrored_second_look_allocates_only_a_second_run_of_tract() {
         steady[0],
         2 * one[WARM_UP],
         "one look: {one:?}, two: {two:?}"
+    );
+}
+
+#[test]
+fn the_quiet_seam_allocates_nothing_beyond_tract() {
+    let one = per_frame(true);
+    let (quiet, _) = per_frame_sim(Some(Schedule::Inline), false, Seam::Quiet, None);
+    println!("allocations per frame, Methods A and B from the quiet seam: {quiet:?}");
+    let steady = &quiet[WARM_UP..];
+    assert!(
+        steady.iter().all(|&n| n == one[WARM_UP]),
+        "fixed seam: {one:?}, quiet: {quiet:?}"
     );
 }
 
@@ -259,7 +274,7 @@ fn serial_source_with_reader_threads_allocates_nothing_after_warm_up() {
     let mut pose = PoseInput::new(PoseState::new(cfg.pose_filter(None), false));
     let compass: firmware::reader::CompassReader = Box::new(|| Ok([21.5, -3.2, 40.1]));
     pose.devices = Some(firmware::reader::DeviceReader::start(None, Some(compass)).unwrap());
-    let d = per_frame_from(source, pose, None, false, None).0;
+    let d = per_frame_from(source, pose, None, false, Seam::Fixed, None).0;
     stop.store(true, std::sync::atomic::Ordering::Relaxed);
     player.join().unwrap();
     println!("allocations per frame, serial LDS-01 + device thread, Method A: {d:?}");

@@ -75,6 +75,8 @@
 //!                              # worker on a Pi 3 when live, else inline (docs/pi-budget.md)
 //! every = 1                    # in the frame: Method B in one frame of this many
 //! mirror = false               # a second look at the mirrored raster, fused (twice the time)
+//! seam = "fixed"               # the raster's first column: "fixed" (forward) or "quiet" (the
+//!                              # longest unbroken wall); must be the model's training rule
 //! ```
 
 use std::fmt;
@@ -302,6 +304,8 @@ pub struct MethodBSettings {
     /// A second look at the mirrored raster, its boxes fused with the first's
     /// (`perception::mirror_look`).
     pub mirror: bool,
+    /// Where the raster starts (`perception::seam`): the rule the model was trained with.
+    pub seam: crate::runner::Seam,
 }
 
 impl Default for MethodBSettings {
@@ -318,6 +322,7 @@ impl Default for MethodBSettings {
             schedule: crate::runner::Schedule::Auto,
             every: 1,
             mirror: false,
+            seam: crate::runner::Seam::Fixed,
         }
     }
 }

@@ -214,6 +214,7 @@ mod tests {
             schedule: Schedule::Worker,
             every: 1,
             mirror: false,
+            seam: crate::runner::Seam::Fixed,
         }
     }
 

@@ -9,6 +9,7 @@ use perception::fusion::PlacedBox;
 use perception::geometry::Pose2;
 use perception::mirror_look::{FuseConfig, fuse_second_look, mirror_chw};
 use perception::raster::{RasterConfig, SCAN_COLUMNS, encode_chw_f32};
+use perception::seam::{Rolled, SeamRule, turned};
 use perception::yolo::{ANCHORS, DecodeConfig, DecodeScratch, Detection, MAX_DETECTIONS, decode};
 
 /// Method B's network: an input tensor to fill and a run that hands its output to a closure.
@@ -69,6 +70,28 @@ impl Schedule {
     }
 }
 
+/// Where the raster starts (`[method_b] seam`, `perception::seam`): it must be the rule the
+/// model's training images were drawn with.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Seam {
+    /// Bin 0, the LiDAR's forward axis, in the first column.
+    #[default]
+    Fixed,
+    /// The middle of the longest unbroken surface in the first column.
+    Quiet,
+}
+
+impl Seam {
+    /// The rule in `perception`'s terms.
+    pub fn rule(self) -> SeamRule {
+        match self {
+            Seam::Fixed => SeamRule::Fixed,
+            Seam::Quiet => SeamRule::Quiet,
+        }
+    }
+}
+
 /// Method B at run time: the loaded model and how to read its boxes.
 pub struct MethodBSetup {
     /// The network, loaded and optimised at start-up.
@@ -88,6 +111,8 @@ pub struct MethodBSetup {
     /// A second look at the mirrored raster, fused with the first
     /// (`perception::mirror_look`): twice the network's time.
     pub mirror: bool,
+    /// Where the raster starts.
+    pub seam: Seam,
 }
 
 /// Method B's working memory, allocated once.
@@ -121,7 +146,14 @@ impl MethodBSetup {
         scratch: &mut MethodBScratch,
         mut place: impl FnMut(PlacedBox),
     ) -> Result<(), String> {
-        encode_chw_f32(self.model.input_mut(), scans, &self.raster).map_err(|e| e.to_string())?;
+        let seam = self.seam.rule().seam(scans, &self.raster);
+        let rolled = scans.map(|scan| Rolled { scan, seam });
+        encode_chw_f32(
+            self.model.input_mut(),
+            [&rolled[0], &rolled[1], &rolled[2]],
+            &self.raster,
+        )
+        .map_err(|e| e.to_string())?;
         let fuse_cfg = FuseConfig::of(&self.decode);
         let cfg = if self.mirror {
             fuse_cfg.look_decode(&self.decode)
@@ -145,7 +177,8 @@ impl MethodBSetup {
             let s = &mut *scratch;
             fuse_second_look(&mut s.detections, &mut s.second, &fuse_cfg, &mut s.fused);
         }
-        let lidar = middle.compose(&self.mount);
+        // Column c is bearing c + seam.
+        let lidar = turned(&middle.compose(&self.mount), seam);
         for d in scratch.detections.iter() {
             let centre = d.centre(&lidar, &self.raster);
             let range = centre.distance(perception::geometry::Point2::new(lidar.x, lidar.y));

@@ -1,6 +1,6 @@
 //! `umbra-sim`: the simulator's command line.
 //!
-//! * `umbra-sim dataset --out DIR [--scenarios 50] [--frames 200] [--seed 1] [--kinds rect,lshape,tworooms] [--clutter 3] [--varied 0.5] [--office-chairs 0.4] [--round-tables 0.4] [--test-only]`
+//! * `umbra-sim dataset --out DIR [--scenarios 50] [--frames 200] [--seed 1] [--kinds rect,lshape,tworooms] [--clutter 3] [--varied 0.5] [--office-chairs 0.4] [--round-tables 0.4] [--test-only] [--seam fixed|quiet]`
 //!   writes the datasets of `sim::dataset` with a progress bar.
 //! * `umbra-sim speed [--scenarios 16] [--frames 200]` measures labelled frames per second
 //!   with rasters and labels built in memory.
@@ -14,6 +14,7 @@ use std::time::Instant;
 
 use clap::{Parser, Subcommand, ValueEnum};
 use indicatif::{ProgressBar, ProgressStyle};
+use perception::seam::SeamRule;
 use sim::corrupt::{Corruption, corrupt};
 use sim::dataset::{DatasetConfig, generate, in_memory, simulate};
 use sim::lds01::Lds01SimConfig;
@@ -36,6 +37,12 @@ enum Kind {
     Lshape,
     Tworooms,
     Notch,
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+enum Seam {
+    Fixed,
+    Quiet,
 }
 
 #[derive(Subcommand)]
@@ -90,6 +97,11 @@ enum Command {
         /// not take for furniture).
         #[arg(long, default_value_t = 0)]
         people: usize,
+        /// Where each image starts: `fixed` (bin 0, the LiDAR's forward axis, first) or `quiet`
+        /// (the middle of the longest unbroken surface first: `perception::seam`), as the
+        /// runtime's `[method_b] seam` does.
+        #[arg(long, value_enum, default_value_t = Seam::Fixed)]
+        seam: Seam,
     },
     /// Labelled frames per second, rasters and labels in memory.
     Speed {
@@ -181,6 +193,7 @@ fn run(command: Command) -> Result<(), String> {
             pictures,
             test_only,
             people,
+            seam,
         } => {
             let cfg = DatasetConfig {
                 scenarios,
@@ -200,6 +213,10 @@ fn run(command: Command) -> Result<(), String> {
                 pictures,
                 test_only,
                 people,
+                seam: match seam {
+                    Seam::Fixed => SeamRule::Fixed,
+                    Seam::Quiet => SeamRule::Quiet,
+                },
                 ..DatasetConfig::default()
             };
             let bar = ProgressBar::new((scenarios * frames) as u64);
