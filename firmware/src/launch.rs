@@ -539,6 +539,7 @@ fn load_method_b(
         every: cfg.method_b.every,
         mirror: cfg.method_b.mirror,
         seam: cfg.method_b.seam,
+        deskew: cfg.method_b.deskew,
     }))
 }
 

@@ -12,6 +12,7 @@
 //! | [`scan_match`] | each revolution laid on a keyframe's (point-to-line ICP): a pose that does not drift |
 //! | [`raster`]     | three revolutions as the 64 × 384 × 3 image of Method B (bit-exact spec) |
 //! | [`seam`]       | where the raster starts: its edges on a plain wall, not through furniture |
+//! | [`sweep`]      | where the LiDAR stood when it read each bearing of a revolution |
 //! | [`cloud`]      | Method A's global point cloud: a fixed ring with aging |
 //! | [`dbscan`]     | adaptive-ε DBSCAN, grid-indexed and allocation-free |
 //! | [`shape`]      | centroid, principal-axes and minimum-area boxes of point sets |
@@ -67,6 +68,7 @@ pub mod seam;
 pub mod shape;
 pub mod sight;
 pub mod still_legs;
+pub mod sweep;
 pub mod tracks;
 pub mod wall_map;
 pub mod wall_piece;

@@ -70,6 +70,9 @@ pub struct DatasetConfig {
     pub people: usize,
     /// Where each image starts (`perception::seam`); its labels follow.
     pub seam: SeamRule,
+    /// Labels drawn as the sweep read each footprint (`sim::labels::swept_box`), not from the
+    /// pose at the middle of the revolution.
+    pub deskew: bool,
 }
 
 impl Default for DatasetConfig {
@@ -87,6 +90,7 @@ impl Default for DatasetConfig {
             test_only: false,
             people: 0,
             seam: SeamRule::Fixed,
+            deskew: false,
         }
     }
 }
@@ -225,6 +229,7 @@ pub fn simulate(
             [&ring[t], &ring[t1], &ring[t2]],
             &cfg.raster,
             seam,
+            cfg.deskew,
             &mut boxes,
         );
         on_sample(

@@ -20,6 +20,7 @@ use perception::class::ObjectClass;
 use perception::geometry::{Point2, Pose2};
 use perception::raster::{RASTER_H, RASTER_W, RasterConfig, SCAN_COLUMNS, row_for_range};
 use perception::seam::turned;
+use perception::sweep::Sweep;
 
 use crate::lds01::LIDAR_MOUNT;
 use crate::scenario::Frame;
@@ -95,7 +96,29 @@ pub fn footprint_box(
     cfg: &RasterConfig,
 ) -> Option<PixelBox> {
     let inv = lidar.inverse();
-    let local = footprint.map(|c| inv.transform(c));
+    local_box(class, footprint.map(|c| inv.transform(c)), cfg)
+}
+
+/// The box of a footprint as the sweep read it: each corner at the bearing, and from the
+/// LiDAR's place, of the instant its bearing was read (`perception::sweep`), then turned to
+/// the image's first column `seam`. In range or `None`, as [`footprint_box`].
+pub fn swept_box(
+    class: ObjectClass,
+    footprint: &[Point2; 4],
+    sweep: &Sweep,
+    seam: usize,
+    cfg: &RasterConfig,
+) -> Option<PixelBox> {
+    let turn = Pose2::new(0.0, 0.0, (seam as f32).to_radians()).inverse();
+    local_box(
+        class,
+        footprint.map(|c| turn.transform(sweep.bearing_of(c).1)),
+        cfg,
+    )
+}
+
+/// The box of footprint corners given in the image's LiDAR frame.
+fn local_box(class: ObjectClass, local: [Point2; 4], cfg: &RasterConfig) -> Option<PixelBox> {
     let origin = Point2::default();
     let near = (0..4)
         .map(|i| origin.distance_to_segment(local[i], local[(i + 1) % 4]))
@@ -140,25 +163,40 @@ pub fn footprint_box(
 }
 
 /// Boxes for the raster of `frames` = [t, t−1, t−2] drawn from bin `seam` on
-/// (`perception::seam`: column `c` is bearing `c + seam`), appended to `out`.
+/// (`perception::seam`: column `c` is bearing `c + seam`), appended to `out`. `deskew`: each
+/// footprint as revolution t−1's sweep read it ([`swept_box`]); else from the pose at its
+/// middle.
 pub fn yolo_boxes(
     world: &World,
     frames: [&Frame; 3],
     cfg: &RasterConfig,
     seam: usize,
+    deskew: bool,
     out: &mut Vec<PixelBox>,
 ) {
     let lidar = turned(&frames[1].pose_mid.compose(&LIDAR_MOUNT), seam);
+    let sweep = Sweep {
+        start: frames[1].pose_start,
+        end: frames[1].pose_end,
+        mount: LIDAR_MOUNT,
+    };
+    let label = |class, footprint: &[Point2; 4]| {
+        if deskew {
+            swept_box(class, footprint, &sweep, seam, cfg)
+        } else {
+            footprint_box(class, footprint, &lidar, cfg)
+        }
+    };
     for (n, o) in world.objects.iter().enumerate() {
         if returns_of(frames, Surface::Object(n as u16)) >= MIN_RETURNS
-            && let Some(b) = footprint_box(o.class, &o.footprint, &lidar, cfg)
+            && let Some(b) = label(o.class, &o.footprint)
         {
             out.push(b);
         }
     }
     for (n, d) in world.doors.iter().enumerate() {
         if returns_of(frames, Surface::DoorFrame(n as u16)) >= MIN_RETURNS
-            && let Some(b) = footprint_box(ObjectClass::DoorFrame, &d.footprint, &lidar, cfg)
+            && let Some(b) = label(ObjectClass::DoorFrame, &d.footprint)
         {
             out.push(b);
         }
@@ -213,6 +251,75 @@ mod test {
         assert!(b.cx > 340.0 && b.cx + b.w / 2.0 <= 360.0, "{b:?}");
         let line = b.yolo_line();
         assert!(line.starts_with("0 "), "{line}");
+    }
+
+    /// The bins whose ray, cast from where the sweep stood when it read them, crosses the
+    /// footprint: brute force, 1 cm steps.
+    fn bins_hit(fp: &[Point2; 4], sweep: &Sweep) -> Vec<usize> {
+        let inside = |p: Point2| {
+            let mut c = false;
+            for i in 0..4 {
+                let (a, b) = (fp[i], fp[(i + 1) % 4]);
+                if (a.y > p.y) != (b.y > p.y) && p.x < (b.x - a.x) * (p.y - a.y) / (b.y - a.y) + a.x
+                {
+                    c = !c;
+                }
+            }
+            c
+        };
+        (0..360)
+            .filter(|&d| (1..400).any(|k| inside(sweep.point(d as f32, k as f32 * 0.01))))
+            .collect()
+    }
+
+    #[test]
+    fn a_swept_label_covers_the_bins_that_read_it_on_a_turn() {
+        // A tour's turn: 1.5 rad/s and 0.05 m forward in one revolution.
+        let sweep = Sweep {
+            start: Pose2::new(0.0, 0.0, 0.0),
+            end: Pose2::new(0.05, 0.0, 0.3),
+            mount: LIDAR_MOUNT,
+        };
+        let cfg = RasterConfig::default();
+        for (centre, seam) in [
+            (Point2::new(0.0, 2.0), 0),
+            (Point2::new(-1.5, -1.0), 0),
+            (Point2::new(1.2, -1.6), 0),
+            (Point2::new(0.0, 2.0), 37),
+            (Point2::new(1.5, 1.3), 0),
+        ] {
+            let fp = square(centre, 0.25);
+            let hit = bins_hit(&fp, &sweep);
+            let (first, last) = (*hit.first().unwrap(), *hit.last().unwrap());
+            assert_eq!(last - first + 1, hit.len(), "one run of bins: {hit:?}");
+            let b = swept_box(ObjectClass::Box, &fp, &sweep, seam, &cfg).unwrap();
+            // Columns [b0, b1 + 1) padded by PAD_COLS: the bins read are b0..=b1.
+            let (c0, c1) = (
+                b.cx - b.w / 2.0 + PAD_COLS,
+                b.cx + b.w / 2.0 - 1.0 - PAD_COLS,
+            );
+            let (f, l) = ((first - seam) as f32, (last - seam) as f32);
+            // Within the bin each edge falls in (1°): the footprint's bearings at their read
+            // instants.
+            assert!(
+                f - 1.0 <= c0 && c0 <= f + 0.01,
+                "{centre:?}: {c0} vs bins from {f}"
+            );
+            assert!(
+                l - 0.01 <= c1 && c1 <= l + 1.0,
+                "{centre:?}: {c1} vs bins to {l}"
+            );
+            // From the middle's pose the label is off by the turn between the middle and
+            // the read instant: 0.3 rad × (fraction − ½), 4–6° for the bins read 0.25 of a
+            // revolution or more from the middle.
+            let mid = sweep.lidar_at(179.5);
+            let m = footprint_box(ObjectClass::Box, &fp, &turned(&mid, seam), &cfg).unwrap();
+            let off = (m.cx - b.cx).abs();
+            let fraction = (359.0 - (first + last) as f32 / 2.0) / 360.0;
+            if (fraction - 0.5).abs() > 0.2 {
+                assert!(off > 3.0, "{centre:?}: the middle's label only {off}° off");
+            }
+        }
     }
 
     #[test]

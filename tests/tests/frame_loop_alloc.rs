@@ -85,6 +85,7 @@ fn per_frame_from(
         every: 1,
         mirror,
         seam,
+        deskew: false,
     });
     let mut sinks: Vec<Box<dyn FrameSink>> = vec![
         Box::new(JsonlSink(Box::new(Marks(marks.clone())))),

@@ -77,6 +77,8 @@
 //! mirror = false               # a second look at the mirrored raster, fused (twice the time)
 //! seam = "fixed"               # the raster's first column: "fixed" (forward) or "quiet" (the
 //!                              # longest unbroken wall); must be the model's training rule
+//! deskew = false               # boxes read where the sweep read them (models trained on
+//!                              # `umbra-sim dataset --deskew` labels); false: the middle's pose
 //! ```
 
 use std::fmt;
@@ -306,6 +308,9 @@ pub struct MethodBSettings {
     pub mirror: bool,
     /// Where the raster starts (`perception::seam`): the rule the model was trained with.
     pub seam: crate::runner::Seam,
+    /// Boxes read as the sweep read them (`perception::sweep`): the rule the model's labels
+    /// were drawn with.
+    pub deskew: bool,
 }
 
 impl Default for MethodBSettings {
@@ -323,6 +328,7 @@ impl Default for MethodBSettings {
             every: 1,
             mirror: false,
             seam: crate::runner::Seam::Fixed,
+            deskew: false,
         }
     }
 }

@@ -21,6 +21,7 @@ use perception::geometry::Pose2;
 use perception::raster::SCAN_COLUMNS;
 use perception::yolo::MAX_DETECTIONS;
 
+use super::history::RevolutionPose;
 use super::method_b::{MethodBScratch, MethodBSetup};
 
 /// Bytes of the one job buffer that goes back and forth (`memory-budget.md`).
@@ -30,8 +31,8 @@ pub const B_WORKER_JOB_BYTES: usize = core::mem::size_of::<Job>();
 pub(super) struct Job {
     /// The revolutions, newest first.
     scans: [[f32; SCAN_COLUMNS]; 3],
-    /// The robot's pose at the middle of the previous revolution.
-    middle: Pose2,
+    /// The robot's poses during the previous revolution.
+    during: RevolutionPose,
     /// The boxes, placed in the map.
     pub(super) boxes: heapless::Vec<PlacedBox, MAX_DETECTIONS>,
     /// How long the network and the decoding took, ms.
@@ -63,14 +64,14 @@ impl BWorker {
                     let t = Instant::now();
                     let Job {
                         scans,
-                        middle,
+                        during,
                         boxes,
                         ..
                     } = &mut *job;
                     boxes.clear();
                     let r = setup.frame(
                         [&scans[0], &scans[1], &scans[2]],
-                        *middle,
+                        *during,
                         &mut scratch,
                         |p| {
                             // The decoder keeps at most MAX_DETECTIONS: this always fits.
@@ -95,7 +96,7 @@ impl BWorker {
             from_worker,
             spare: Some(Box::new(Job {
                 scans: [[0.0; SCAN_COLUMNS]; 3],
-                middle: Pose2::IDENTITY,
+                during: RevolutionPose::still(Pose2::IDENTITY),
                 boxes: heapless::Vec::new(),
                 ms: 0.0,
                 failed: false,
@@ -121,14 +122,18 @@ impl BWorker {
 
     /// Hands three revolutions (newest first) to the worker; `false` while it is still busy
     /// with the last ones (or gone).
-    pub(super) fn offer(&mut self, scans: [&[f32; SCAN_COLUMNS]; 3], middle: Pose2) -> bool {
+    pub(super) fn offer(
+        &mut self,
+        scans: [&[f32; SCAN_COLUMNS]; 3],
+        during: RevolutionPose,
+    ) -> bool {
         let (Some(mut job), Some(tx)) = (self.spare.take(), self.to_worker.as_ref()) else {
             return false;
         };
         for (dst, src) in job.scans.iter_mut().zip(scans) {
             dst.copy_from_slice(src);
         }
-        job.middle = middle;
+        job.during = during;
         match tx.try_send(job) {
             Ok(()) => true,
             // Full cannot happen with one buffer in circulation; disconnected: the worker is
@@ -168,6 +173,7 @@ impl Drop for BWorker {
 mod tests {
     use super::*;
     use crate::runner::{Network, Schedule};
+    use perception::geometry::Point2;
     use perception::raster::RasterConfig;
     use perception::yolo::{ANCHORS, DFL_BINS, DecodeConfig, LOGITS_LEN};
     use std::sync::{Arc, Barrier};
@@ -215,6 +221,7 @@ mod tests {
             every: 1,
             mirror: false,
             seam: crate::runner::Seam::Fixed,
+            deskew: false,
         }
     }
 
@@ -229,7 +236,7 @@ mod tests {
     #[test]
     fn the_worker_gives_the_boxes_the_frame_would_and_refuses_work_while_busy() {
         let s = scans();
-        let middle = Pose2::new(1.0, 2.0, 0.5);
+        let middle = RevolutionPose::still(Pose2::new(1.0, 2.0, 0.5));
         let mut inline = Vec::new();
         setup(None)
             .frame(
@@ -258,6 +265,53 @@ mod tests {
         assert!(w.offer([&s[0], &s[1], &s[2]], middle));
         gate.wait();
         drop(w); // joins the thread after its run
+    }
+
+    #[test]
+    fn deskewed_boxes_are_placed_where_the_sweep_read_them() {
+        let s = scans();
+        let place = |deskew: bool, during: RevolutionPose| {
+            let mut b = setup(None);
+            b.deskew = deskew;
+            let mut got = Vec::new();
+            b.frame(
+                [&s[0], &s[1], &s[2]],
+                during,
+                &mut MethodBScratch::default(),
+                |p| got.push(p),
+            )
+            .unwrap();
+            got
+        };
+        // Turning at 1.5 rad/s through one revolution.
+        let turning = RevolutionPose {
+            start: Pose2::new(1.0, 2.0, 0.2),
+            end: Pose2::new(1.0, 2.0, 0.5),
+        };
+        let (mid, swept) = (place(false, turning), place(true, turning));
+        let sweep = perception::sweep::Sweep {
+            start: turning.start,
+            end: turning.end,
+            mount: Pose2::new(-0.03, 0.0, 0.0),
+        };
+        let lidar_mid = turning.middle().compose(&sweep.mount);
+        for (m, w) in mid.iter().zip(&swept) {
+            let range = m.centre.distance(Point2::new(lidar_mid.x, lidar_mid.y));
+            let want = sweep.point(m.bbox[0] - 0.5, range);
+            assert!(w.centre.distance(want) < 1e-3, "{w:?} vs {want:?}");
+            // Read 0.1–0.4 of a revolution from the middle: 3–10 cm apart at 1.5 m.
+            let apart = w.centre.distance(m.centre);
+            let fraction = (359.0 - (m.bbox[0] - 0.5)) / 360.0;
+            assert!(
+                apart > 0.25 * (fraction - 0.5).abs() * range,
+                "{apart} m apart at fraction {fraction}"
+            );
+        }
+        // A robot standing still reads every bearing from one place: the same boxes.
+        let still = RevolutionPose::still(Pose2::new(1.0, 2.0, 0.5));
+        for (m, w) in place(false, still).iter().zip(&place(true, still)) {
+            assert!(m.centre.distance(w.centre) < 1e-4);
+        }
     }
 
     #[test]

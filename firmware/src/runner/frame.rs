@@ -21,7 +21,7 @@ use perception::wall_piece::drop_wall_pieces;
 
 use super::FrameLoop;
 use super::b_worker::BWorker;
-use super::history::ScanHistory;
+use super::history::{RevolutionPose, ScanHistory};
 use super::method_b::MethodBScratch;
 use crate::deadline::{DeadlineRecord, FrameTimes, Policy, SHRINK_DROP_FRACTION};
 use crate::odom::{FramePose, PoseInput};
@@ -221,11 +221,11 @@ impl FrameState {
     /// Method B on the last three revolutions; its boxes join the frame's objects. A failed
     /// frame is counted (and said once) and the frame goes on without it.
     fn method_b(&mut self, b: &mut super::MethodBSetup) {
-        let Some((scans, middle)) = self.history.three() else {
+        let Some((scans, during)) = self.history.three() else {
             return;
         };
         let fused = &mut self.fused;
-        if let Err(e) = b.frame(scans, middle, &mut self.b_scratch, |placed| {
+        if let Err(e) = b.frame(scans, during, &mut self.b_scratch, |placed| {
             merge_b(fused, &placed);
         }) {
             if self.method_b_errors == 0 {
@@ -251,8 +251,8 @@ impl FrameState {
         }) {
             self.method_b_runs += 1;
         }
-        if let Some((scans, middle)) = self.history.three() {
-            worker.offer(scans, middle);
+        if let Some((scans, during)) = self.history.three() {
+            worker.offer(scans, during);
         }
         ms
     }
@@ -338,7 +338,10 @@ impl<S: RevolutionStream> FrameLoop<'_, S> {
             st.policy.method_a_took(ms);
             ms
         });
-        st.history.commit(pose.start.midway(&pose.end));
+        st.history.commit(RevolutionPose {
+            start: pose.start,
+            end: pose.end,
+        });
 
         // Method B, unless the overrun policy sheds it (no room left, or decimated while
         // behind the LiDAR).

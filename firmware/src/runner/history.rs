@@ -1,9 +1,30 @@
-//! The last three revolutions' ranges by bin and the robot's pose at the middle of each: Method
-//! A reads the newest, Method B's raster all three, the recorder the newest. Fixed size,
-//! allocated once.
+//! The last three revolutions' ranges by bin and the robot's poses at the first and last ray
+//! of each: Method A reads the newest, Method B's raster all three, the recorder the newest.
+//! Fixed size, allocated once.
 
 use perception::geometry::Pose2;
 use perception::raster::SCAN_COLUMNS;
+
+/// The robot's map pose at a revolution's first and last ray.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RevolutionPose {
+    /// At the first ray.
+    pub start: Pose2,
+    /// At the last ray.
+    pub end: Pose2,
+}
+
+impl RevolutionPose {
+    /// A robot standing at `p` for the whole revolution.
+    pub const fn still(p: Pose2) -> Self {
+        RevolutionPose { start: p, end: p }
+    }
+
+    /// The pose at the middle of the revolution.
+    pub fn middle(&self) -> Pose2 {
+        self.start.midway(&self.end)
+    }
+}
 
 /// Revolutions Method B's raster is made of.
 pub const METHOD_B_HISTORY: usize = perception::raster::RASTER_C;
@@ -12,8 +33,8 @@ pub const METHOD_B_HISTORY: usize = perception::raster::RASTER_C;
 pub struct ScanHistory {
     /// Ranges by bin (0 = not drawn), slot `n % 3` for the n-th revolution.
     ranges: [[f32; SCAN_COLUMNS]; METHOD_B_HISTORY],
-    /// The robot's map pose at the middle of each of those revolutions.
-    poses: [Pose2; METHOD_B_HISTORY],
+    /// The robot's map poses during each of those revolutions.
+    poses: [RevolutionPose; METHOD_B_HISTORY],
     /// Revolutions put in so far.
     revolutions: u64,
 }
@@ -22,7 +43,7 @@ impl Default for ScanHistory {
     fn default() -> Self {
         ScanHistory {
             ranges: [[0.0; SCAN_COLUMNS]; METHOD_B_HISTORY],
-            poses: [Pose2::IDENTITY; METHOD_B_HISTORY],
+            poses: [RevolutionPose::still(Pose2::IDENTITY); METHOD_B_HISTORY],
             revolutions: 0,
         }
     }
@@ -46,10 +67,10 @@ impl ScanHistory {
         &self.ranges[self.slot()]
     }
 
-    /// Closes the pending revolution with the pose at its middle.
-    pub fn commit(&mut self, mid_pose: Pose2) {
+    /// Closes the pending revolution with the robot's poses during it.
+    pub fn commit(&mut self, pose: RevolutionPose) {
         let s = self.slot();
-        self.poses[s] = mid_pose;
+        self.poses[s] = pose;
         self.revolutions += 1;
     }
 
@@ -63,9 +84,9 @@ impl ScanHistory {
         &self.ranges[self.index(0)]
     }
 
-    /// The three revolutions, newest first, and the pose at the middle of the previous one
-    /// (the pose Method B's labels were drawn at). `None` before three are in.
-    pub fn three(&self) -> Option<([&[f32; SCAN_COLUMNS]; 3], Pose2)> {
+    /// The three revolutions, newest first, and the robot's poses during the previous one
+    /// (the revolution Method B's labels are drawn from). `None` before three are in.
+    pub fn three(&self) -> Option<([&[f32; SCAN_COLUMNS]; 3], RevolutionPose)> {
         (self.revolutions >= METHOD_B_HISTORY as u64).then(|| {
             let (newest, prev, oldest) = (self.index(0), self.index(1), self.index(2));
             (
@@ -94,14 +115,14 @@ mod test {
         let mut h = ScanHistory::default();
         for n in 0..5u8 {
             h.next_mut().fill(f32::from(n));
-            h.commit(Pose2::new(f32::from(n), 0.0, 0.0));
+            h.commit(RevolutionPose::still(Pose2::new(f32::from(n), 0.0, 0.0)));
             if n < 2 {
                 assert!(h.three().is_none());
             }
         }
         let (scans, pose) = h.three().unwrap();
         assert_eq!([scans[0][0], scans[1][0], scans[2][0]], [4.0, 3.0, 2.0]);
-        assert_eq!(pose.x, 3.0);
+        assert_eq!(pose.middle().x, 3.0);
         assert_eq!(h.newest()[0], 4.0);
         assert_eq!(h.revolutions(), 5);
     }

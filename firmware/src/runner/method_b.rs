@@ -10,6 +10,9 @@ use perception::geometry::Pose2;
 use perception::mirror_look::{FuseConfig, fuse_second_look, mirror_chw};
 use perception::raster::{RasterConfig, SCAN_COLUMNS, encode_chw_f32};
 use perception::seam::{Rolled, SeamRule, turned};
+use perception::sweep::Sweep;
+
+use super::history::RevolutionPose;
 use perception::yolo::{ANCHORS, DecodeConfig, DecodeScratch, Detection, MAX_DETECTIONS, decode};
 
 /// Method B's network: an input tensor to fill and a run that hands its output to a closure.
@@ -113,6 +116,10 @@ pub struct MethodBSetup {
     pub mirror: bool,
     /// Where the raster starts.
     pub seam: Seam,
+    /// Boxes read as the sweep read them (`perception::sweep`): for models trained on labels
+    /// drawn that way (`umbra-sim dataset --deskew`); else from the pose at the revolution's
+    /// middle.
+    pub deskew: bool,
 }
 
 /// Method B's working memory, allocated once.
@@ -137,12 +144,12 @@ impl Default for MethodBScratch {
 
 impl MethodBSetup {
     /// Runs on three revolutions (newest first) and calls `place` with each box in the map;
-    /// `middle` is the robot's pose at the middle of the previous revolution. `Err` carries
-    /// the message of a failed frame.
+    /// `during` is the robot's poses during the previous revolution (the labels' revolution).
+    /// `Err` carries the message of a failed frame.
     pub fn frame(
         &mut self,
         scans: [&[f32; SCAN_COLUMNS]; 3],
-        middle: Pose2,
+        during: RevolutionPose,
         scratch: &mut MethodBScratch,
         mut place: impl FnMut(PlacedBox),
     ) -> Result<(), String> {
@@ -177,10 +184,21 @@ impl MethodBSetup {
             let s = &mut *scratch;
             fuse_second_look(&mut s.detections, &mut s.second, &fuse_cfg, &mut s.fused);
         }
-        // Column c is bearing c + seam.
-        let lidar = turned(&middle.compose(&self.mount), seam);
+        // Column c is bearing c + seam; read from the pose at the middle of the revolution,
+        // or (`deskew`) from where the sweep stood when it read that bearing.
+        let lidar = turned(&during.middle().compose(&self.mount), seam);
+        let sweep = Sweep {
+            start: during.start,
+            end: during.end,
+            mount: self.mount,
+        };
         for d in scratch.detections.iter() {
-            let centre = d.centre(&lidar, &self.raster);
+            let centre = if self.deskew {
+                let (range, bearing) = d.polar(&self.raster);
+                sweep.point(bearing.to_degrees() + seam as f32, range)
+            } else {
+                d.centre(&lidar, &self.raster)
+            };
             let range = centre.distance(perception::geometry::Point2::new(lidar.x, lidar.y));
             place(PlacedBox {
                 class: d.class,

@@ -1,6 +1,6 @@
 //! `umbra-sim`: the simulator's command line.
 //!
-//! * `umbra-sim dataset --out DIR [--scenarios 50] [--frames 200] [--seed 1] [--kinds rect,lshape,tworooms] [--clutter 3] [--varied 0.5] [--office-chairs 0.4] [--round-tables 0.4] [--test-only] [--seam fixed|quiet]`
+//! * `umbra-sim dataset --out DIR [--scenarios 50] [--frames 200] [--seed 1] [--kinds rect,lshape,tworooms] [--clutter 3] [--varied 0.5] [--office-chairs 0.4] [--round-tables 0.4] [--test-only] [--seam fixed|quiet] [--deskew]`
 //!   writes the datasets of `sim::dataset` with a progress bar.
 //! * `umbra-sim speed [--scenarios 16] [--frames 200]` measures labelled frames per second
 //!   with rasters and labels built in memory.
@@ -102,6 +102,11 @@ enum Command {
         /// runtime's `[method_b] seam` does.
         #[arg(long, value_enum, default_value_t = Seam::Fixed)]
         seam: Seam,
+        /// Labels as the sweep read each footprint (each corner at the bearing and from the
+        /// place of its read instant), as the runtime's `[method_b] deskew` decodes them; by
+        /// default from the robot's pose at the middle of the revolution.
+        #[arg(long)]
+        deskew: bool,
     },
     /// Labelled frames per second, rasters and labels in memory.
     Speed {
@@ -194,6 +199,7 @@ fn run(command: Command) -> Result<(), String> {
             test_only,
             people,
             seam,
+            deskew,
         } => {
             let cfg = DatasetConfig {
                 scenarios,
@@ -217,6 +223,7 @@ fn run(command: Command) -> Result<(), String> {
                     Seam::Fixed => SeamRule::Fixed,
                     Seam::Quiet => SeamRule::Quiet,
                 },
+                deskew,
                 ..DatasetConfig::default()
             };
             let bar = ProgressBar::new((scenarios * frames) as u64);
