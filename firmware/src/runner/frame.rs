@@ -30,7 +30,6 @@ use crate::output::{
 };
 use crate::record_format::RECORD_RAW_BYTES;
 use crate::sink::FrameView;
-use crate::source::Pacing;
 use drivers::lidar::RevolutionStream;
 
 /// A Method B door frame this close to a door of Method A's is that door, m.
@@ -287,12 +286,7 @@ impl<S: RevolutionStream> FrameLoop<'_, S> {
         let Some(rev) = stream.last_revolution() else {
             return Ok(false);
         };
-        if opts.pacing == Pacing::Max {
-            // Nothing paces the source: the sinks catch up before the frame's clock starts.
-            for sink in opts.sinks.iter_mut() {
-                sink.make_room();
-            }
-        }
+        super::make_room(opts);
         let t_frame = Instant::now();
         let frame = summary.frames;
         let valid = rev.valid_count() as u32;
@@ -338,10 +332,7 @@ impl<S: RevolutionStream> FrameLoop<'_, S> {
             st.policy.method_a_took(ms);
             ms
         });
-        st.history.commit(RevolutionPose {
-            start: pose.start,
-            end: pose.end,
-        });
+        st.history.commit(RevolutionPose::new(pose.start, pose.end));
 
         // Method B, unless the overrun policy sheds it (no room left, or decimated while
         // behind the LiDAR).

@@ -15,6 +15,11 @@ pub struct RevolutionPose {
 }
 
 impl RevolutionPose {
+    /// The poses at the first and the last ray.
+    pub const fn new(start: Pose2, end: Pose2) -> Self {
+        RevolutionPose { start, end }
+    }
+
     /// A robot standing at `p` for the whole revolution.
     pub const fn still(p: Pose2) -> Self {
         RevolutionPose { start: p, end: p }

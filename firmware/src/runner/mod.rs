@@ -307,6 +307,16 @@ impl<S: RevolutionStream> FrameLoop<'_, S> {
     }
 }
 
+/// Before a frame's clock starts: when nothing paces the source (`Pacing::Max`), the sinks
+/// catch up ([`crate::sink::FrameSink::make_room`]), so such a run's recording is complete.
+fn make_room(opts: &mut RunOptions) {
+    if opts.pacing == Pacing::Max {
+        for sink in opts.sinks.iter_mut() {
+            sink.make_room();
+        }
+    }
+}
+
 /// Whether the loop has fallen more than a revolution behind the LiDAR: bytes queued on a
 /// port, or (simulated robot paced in real time) wall time ahead of the sensor clock.
 fn behind_lidar(
