@@ -78,13 +78,12 @@ impl Scan<'_> {
     pub fn lidar_at(&self, d: usize) -> Pose2 {
         let n = self.ranges.len().max(1);
         let u = (n - 1 - d.min(n - 1)) as f32 / n as f32;
-        let dtheta = crate::geometry::wrap_angle(self.end.theta - self.start.theta);
-        Pose2::new(
-            self.start.x + (self.end.x - self.start.x) * u,
-            self.start.y + (self.end.y - self.start.y) * u,
-            self.start.theta + dtheta * u,
-        )
-        .compose(&self.mount)
+        crate::sweep::Sweep {
+            start: self.start,
+            end: self.end,
+            mount: self.mount,
+        }
+        .lidar_at_fraction(u)
     }
 }
 

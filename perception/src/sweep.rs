@@ -32,7 +32,13 @@ impl Sweep {
     /// The LiDAR's pose (map frame) when it read bearing `deg` (any real number of degrees).
     pub fn lidar_at(&self, deg: f32) -> Pose2 {
         let f = (359.0 - deg) / 360.0;
-        let u = f - libm::floorf(f);
+        self.lidar_at_fraction(f - libm::floorf(f))
+    }
+
+    /// The LiDAR's pose (map frame) at fraction `u` of the way from the first ray to the last:
+    /// the robot's pose interpolated, then the mount. The one interpolation of a revolution's
+    /// poses ([`crate::cloud::Scan::lidar_at`] reads its bins through it too).
+    pub fn lidar_at_fraction(&self, u: f32) -> Pose2 {
         let dtheta = wrap_angle(self.end.theta - self.start.theta);
         Pose2::new(
             self.start.x + (self.end.x - self.start.x) * u,

@@ -109,7 +109,7 @@ pub fn swept_box(
     seam: usize,
     cfg: &RasterConfig,
 ) -> Option<PixelBox> {
-    let turn = Pose2::new(0.0, 0.0, (seam as f32).to_radians()).inverse();
+    let turn = turned(&Pose2::IDENTITY, seam).inverse();
     local_box(
         class,
         footprint.map(|c| turn.transform(sweep.bearing_of(c).1)),

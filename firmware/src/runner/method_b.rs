@@ -1,6 +1,7 @@
 //! Method B as a stage of the frame: the last three revolutions encoded as the 64 × 384 × 3
 //! raster into the network's input, the network run, its boxes decoded and placed in the map
-//! from the middle revolution's pose (the pose the training labels used).
+//! from the middle revolution's poses, the way the training labels were drawn (its middle's
+//! pose, or with `deskew` where the sweep stood when it read each box's bearing).
 //!
 //! The network is behind the [`Network`] trait so that the loop builds the same with and
 //! without tract (feature `method-b`: `models::yolo::YoloModel` implements it).
@@ -11,9 +12,9 @@ use perception::mirror_look::{FuseConfig, fuse_second_look, mirror_chw};
 use perception::raster::{RasterConfig, SCAN_COLUMNS, encode_chw_f32};
 use perception::seam::{Rolled, SeamRule, turned};
 use perception::sweep::Sweep;
+use perception::yolo::{ANCHORS, DecodeConfig, DecodeScratch, Detection, MAX_DETECTIONS, decode};
 
 use super::history::RevolutionPose;
-use perception::yolo::{ANCHORS, DecodeConfig, DecodeScratch, Detection, MAX_DETECTIONS, decode};
 
 /// Method B's network: an input tensor to fill and a run that hands its output to a closure.
 pub trait Network {
