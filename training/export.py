@@ -1,7 +1,7 @@
 """Export a trained checkpoint to the ONNX files the runtime loads.
 
     python training/export.py --weights runs/NAME/weights/best.pt --out models/yolo \
-        [--calib DATASET/images/train --calib-images 256]
+        --seam fixed --deskew false [--calib DATASET/images/train --calib-images 256]
 
 Writes `umbra-yolov8n.onnx` (fp32, opset 17, simplified, static 1x3x64x384 -> 1x68x504: the
 graph cut before its box decoding by `logits_head.py`; the runtime's decoder does that part)
@@ -12,9 +12,17 @@ up to 7 px). QDQ is run in float by tract (slower than fp32), and QOperator on a
 `QLinearSigmoid`, which tract rejects. `--full-head` keeps Ultralytics' 1x8x504 output (the
 runtime reads both forms).
 Calibration images are the first N of the folder in name order (deterministic).
+
+Both files declare how their training images were drawn, as ONNX metadata the runtime reads
+(`models/src/conventions.rs`): `umbra.seam` (`--seam`: `fixed`, bin 0 first, or `quiet`) and
+`umbra.deskew` (`--deskew true|false`: labels drawn where the sweep read them). They must be
+the flags the training set was made with (`umbra-sim dataset --seam ... --deskew`); with
+`--data DATASET` they are read from its `dataset.json`. Nothing is assumed: an export that says
+neither, from a set that does not record them, stops with an error.
 """
 
 import argparse
+import json
 import shutil
 from pathlib import Path
 
@@ -69,6 +77,31 @@ def quantise(fp32: Path, out: Path, calib: Path, n: int, per_channel: bool = Fal
     )
 
 
+SEAM_KEY, DESKEW_KEY = "umbra.seam", "umbra.deskew"
+
+
+def declare(path: Path, seam: str, deskew: bool) -> None:
+    """Writes the drawing conventions into `path`'s metadata (replacing earlier values)."""
+    import onnx
+
+    m = onnx.load(str(path))
+    keep = [p for p in m.metadata_props if p.key not in (SEAM_KEY, DESKEW_KEY)]
+    del m.metadata_props[:]
+    m.metadata_props.extend(keep)
+    for k, v in ((SEAM_KEY, seam), (DESKEW_KEY, "true" if deskew else "false")):
+        e = m.metadata_props.add()
+        e.key, e.value = k, v
+    onnx.save(m, str(path))
+
+
+def conventions_of(data: Path) -> tuple[str | None, bool | None]:
+    """The seam rule and swept labels a dataset was made with (its `dataset.json`); `None`
+    where it does not say (sets made before `umbra-sim` recorded them)."""
+    d = json.loads((data / "dataset.json").read_text())
+    deskew = d.get("deskew")
+    return d.get("seam"), None if deskew is None else bool(deskew)
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--weights", required=True)
@@ -82,7 +115,19 @@ def main() -> None:
                     "--float-head` trains; a checkpoint of such a run is recognised without it)")
     ap.add_argument("--full-head", action="store_true",
                     help="keep the DFL and box decoding in the graph (1x8x504)")
+    ap.add_argument("--seam", choices=("fixed", "quiet"),
+                    help="the training images' seam rule (else --data's)")
+    ap.add_argument("--deskew", choices=("true", "false"),
+                    help="whether the training labels were swept (else --data's)")
+    ap.add_argument("--data", type=Path,
+                    help="the training set's folder: its dataset.json gives --seam and --deskew")
     a = ap.parse_args()
+    seam, deskew = conventions_of(a.data) if a.data else (None, None)
+    seam = a.seam or seam
+    deskew = deskew if a.deskew is None else a.deskew == "true"
+    if seam is None or deskew is None:
+        ap.error("say how the training images were drawn: --seam and --deskew, or --data with a "
+                 "dataset.json that records them")
     out = Path(a.out)
     out.mkdir(parents=True, exist_ok=True)
     f = ultralytics_onnx(Path(a.weights))
@@ -91,7 +136,8 @@ def main() -> None:
         shutil.copy(f, fp32)
     else:
         logits_head.cut(Path(f), fp32)
-    print(f"wrote {fp32}")
+    declare(fp32, seam, deskew)
+    print(f"wrote {fp32} (seam {seam}, deskew {str(deskew).lower()})")
     if a.calib:
         q = out / "umbra-yolov8n-int8.onnx"
         import onnx
@@ -108,6 +154,7 @@ def main() -> None:
             print(f"int8 on the ranges its quantisation-aware run trained through "
                   f"({len(ranges)} tensors)")
         quantise(fp32, q, Path(a.calib), a.calib_images, a.per_channel, ranges, skip)
+        declare(q, seam, deskew)
         print(f"wrote {q}")
 
 

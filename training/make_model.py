@@ -76,16 +76,23 @@ def dataset(sim: Path, out: Path, args: list[str]) -> dict:
     return json.loads((out / "dataset.json").read_text())
 
 
+def drawing(a) -> list[str]:
+    """The seam rule and swept labels every set of the model is drawn with (none by default,
+    so the stamps of sets made before these flags still hold)."""
+    return (["--seam", a.seam] if a.seam != "fixed" else []) + (["--deskew"] if a.deskew else [])
+
+
 def sets(a) -> dict[str, list[str]]:
     common = ["--frames", str(a.frames)]
     return {
         "train": ["--scenarios", str(a.scenarios), *common, "--seed", str(a.seed), "--kinds",
-                  a.kinds, "--clutter", str(a.clutter)],
+                  a.kinds, "--clutter", str(a.clutter), *drawing(a)],
         "ood": ["--scenarios", str(a.ood_scenarios), *common, "--seed", str(a.seed + 1),
-                "--kinds", a.ood_kinds, "--clutter", str(a.ood_clutter), "--test-only"],
+                "--kinds", a.ood_kinds, "--clutter", str(a.ood_clutter), "--test-only",
+                *drawing(a)],
         "wide": ["--scenarios", str(a.wide_scenarios), "--frames", str(a.wide_frames), "--seed",
                  str(a.wide_seed), "--kinds", a.kinds, "--clutter", str(a.clutter),
-                 "--test-only"],
+                 "--test-only", *drawing(a)],
         "reference": REFERENCE,
     }
 
@@ -257,6 +264,12 @@ def main() -> None:
     ap.add_argument("--wide-scenarios", type=int, default=300)
     ap.add_argument("--wide-frames", type=int, default=5)
     ap.add_argument("--wide-seed", type=int, default=70)
+    ap.add_argument("--seam", choices=("fixed", "quiet"), default="fixed",
+                    help="every set's raster seam (`umbra-sim dataset --seam`); the exported "
+                    "files declare it and the runtime follows")
+    ap.add_argument("--deskew", action="store_true",
+                    help="every set's labels drawn where the sweep read them (`--deskew`); "
+                    "declared in the exported files like --seam")
     ap.add_argument("--epochs", type=int, default=14)
     ap.add_argument("--batch", type=int, default=32)
     ap.add_argument("--mirror", type=float, default=0.5)
@@ -283,11 +296,12 @@ def main() -> None:
     info_path = work / "info.json"
     info = json.loads(info_path.read_text()) if info_path.exists() else {"runs": []}
     info["command"] = ("python training/make_model.py --work DIR "
-                       + " ".join(f"--{k.replace('_', '-')} {v}" for k, v in vars(a).items()
+                       + " ".join(f"--{k.replace('_', '-')}" + ("" if v is True else f" {v}")
+                                  for k, v in vars(a).items()
                                   if k not in ("work", "stages", "resume", "threads", "weights",
                                                "lineage", "int8_weights", "int8_lineage",
                                                "calib")
-                                  and v is not None))
+                                  and v is not None and v is not False))
     info["runs"].append(" ".join(sys.argv[1:]))
     sim, lab = bins() if {"data", "eval"} & set(stages) else (None, None)
     if "data" in stages:
@@ -318,13 +332,14 @@ def main() -> None:
     if "export" in stages:
         best = Path(info.get("best") or Path(info["weights"]) / "best.pt")
         sh([sys.executable, HERE / "export.py", "--weights", best, "--out", MODELS, "--calib",
-            calib, "--calib-images", "256"])
+            calib, "--calib-images", "256", "--seam", a.seam, "--deskew", str(a.deskew).lower()])
         if info.get("int8_weights"):
             # The int8 file from its own (quantisation-aware) weights, calibrated on the
             # images its fine-tuning measured its ranges on; the fp32 file stays `best`'s.
             tmp = work / "int8-export"
             sh([sys.executable, HERE / "export.py", "--weights", info["int8_weights"], "--out",
-                tmp, "--calib", calib, "--calib-images", "256"])
+                tmp, "--calib", calib, "--calib-images", "256", "--seam", a.seam,
+                "--deskew", str(a.deskew).lower()])
             shutil.copy(tmp / "umbra-yolov8n-int8.onnx", MODELS / "umbra-yolov8n-int8.onnx")
         shutil.copy(best, MODELS / "umbra-yolov8n.pt")
     if "eval" in stages:

@@ -16,6 +16,9 @@ environment, `.venv/bin/python training/test_training.py DATASET/data.yaml`).
   checkpoint, they must land on every convolution's input and output tensors of the exported
   graph, and the int8 file made on them must compute what the fake quantisation computes even
   when the images it is calibrated on would give other ranges.
+* the drawing conventions (`export.declare`): a file declares its seam and swept labels once
+  each, as the runtime reads them (`models/src/conventions.rs`), and a dataset's manifest
+  gives them (`export.conventions_of`).
 """
 
 import shutil
@@ -187,7 +190,29 @@ def test_qat_ranges_carried(data: Path, calib: int = 32) -> None:
           f"{w:.3f} on the kept ranges, {wo:.3f} on ranges measured again")
 
 
+def test_conventions_declared() -> None:
+    import json
+
+    import onnx
+
+    from export import DESKEW_KEY, SEAM_KEY, conventions_of, declare
+
+    tmp = Path(tempfile.mkdtemp())
+    f = tmp / "m.onnx"
+    shutil.copy(HERE.parent / "models/yolo/testdata/boxes-form.onnx", f)
+    declare(f, "quiet", True)
+    declare(f, "fixed", False)
+    props = [(p.key, p.value) for p in onnx.load(str(f)).metadata_props]
+    mine = [kv for kv in props if kv[0] in (SEAM_KEY, DESKEW_KEY)]
+    assert sorted(mine) == [(DESKEW_KEY, "false"), (SEAM_KEY, "fixed")], props
+    (tmp / "dataset.json").write_text(json.dumps({"seed": 1}))
+    assert conventions_of(tmp) == (None, None)
+    (tmp / "dataset.json").write_text(json.dumps({"seam": "quiet", "deskew": True}))
+    assert conventions_of(tmp) == ("quiet", True)
+
+
 if __name__ == "__main__":
+    test_conventions_declared()
     test_qat_ranges_carried(Path(sys.argv[1]))
     test_qat_emulates_int8(Path(sys.argv[1]))
     test_qat_emulates_int8(Path(sys.argv[1]), per_channel=True)

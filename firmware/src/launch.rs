@@ -530,6 +530,24 @@ fn load_method_b(
             _ => "in the frame",
         }
     );
+    let declared = model.conventions();
+    let seam = runner::follow_model(
+        "seam",
+        cfg.method_b.seam,
+        declared.seam.map(runner::Seam::from),
+        runner::Seam::Fixed,
+    );
+    let deskew = runner::follow_model("deskew", cfg.method_b.deskew, declared.deskew, false);
+    log::info!(
+        "Method B reads {}: seam {}, boxes placed {}",
+        model.name(),
+        seam.rule().name(),
+        if deskew {
+            "where the sweep read them"
+        } else {
+            "from the revolution's middle"
+        }
+    );
     Ok(Some(MethodBSetup {
         model: Box::new(model),
         raster: cfg.method_b_raster(),
@@ -538,8 +556,8 @@ fn load_method_b(
         schedule,
         every: cfg.method_b.every,
         mirror: cfg.method_b.mirror,
-        seam: cfg.method_b.seam,
-        deskew: cfg.method_b.deskew,
+        seam,
+        deskew,
     }))
 }
 

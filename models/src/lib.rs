@@ -5,6 +5,7 @@
 //! | module            | owns                                                           |
 //! |-------------------|----------------------------------------------------------------|
 //! | [`calibration`]   | the detections' score calibration (`no_std`), from [`calibration_counts`] |
+//! | [`conventions`]   | what a Method B file declares about its images (seam, swept labels; `no_std`) |
 //! | [`forest`]        | the Method A classifier at run time over `const` tables (`no_std`) |
 //! | [`forest_tables`] | the trained forest, generated from `models/data/forest-train.csv` |
 //! | `train`           | the forest trainer and table emitter (`train` feature: the lab's, host only) |
@@ -17,6 +18,7 @@ pub use perception::class::ObjectClass;
 pub mod calibration;
 #[rustfmt::skip]
 pub mod calibration_counts;
+pub mod conventions;
 pub mod forest;
 #[rustfmt::skip]
 pub mod forest_tables;

@@ -11,11 +11,14 @@
 //!
 //! The file is compiled into the binary ([`BUILTIN_ONNX`]); `--model PATH` loads another. A
 //! missing, corrupt or wrong-shaped file is a [`ModelError`] naming the file and what it found.
+//! What the file declares about its training images (its seam, swept labels) is read from its
+//! metadata at load ([`YoloModel::conventions`], [`crate::conventions`]).
 
 use std::fmt;
 use std::path::Path;
 use std::sync::Arc;
 
+use crate::conventions::Conventions;
 use perception::raster::{RASTER_C, RASTER_H, RASTER_LEN, RASTER_W};
 use perception::yolo::{ANCHORS, Head, LOGIT_ROWS, OUTPUT_ROWS};
 use tract_onnx::prelude::*;
@@ -71,6 +74,9 @@ pub enum ModelErrorKind {
     OutputShape(String),
     /// tract could not type or optimise the graph.
     Optimise(String),
+    /// The file's metadata declares a convention this runtime does not know
+    /// ([`crate::conventions`]).
+    Metadata(String),
     /// A run failed.
     Run(String),
 }
@@ -95,6 +101,7 @@ impl fmt::Display for ModelError {
                 )
             }
             ModelErrorKind::Optimise(e) => write!(f, "cannot prepare it for {INPUT_SHAPE:?}: {e}"),
+            ModelErrorKind::Metadata(e) => write!(f, "{e}"),
             ModelErrorKind::Run(e) => write!(f, "inference failed: {e}"),
         }
     }
@@ -121,6 +128,7 @@ type Plan = Arc<TypedRunnableModel>;
 pub struct YoloModel {
     name: String,
     head: Head,
+    conventions: Conventions,
     state: TypedSimpleState,
     input: Arc<Tensor>,
     /// Frames whose input had to be reallocated because tract still held the last one.
@@ -133,6 +141,17 @@ impl fmt::Debug for YoloModel {
             .field("name", &self.name)
             .finish()
     }
+}
+
+/// The conventions in the ONNX `metadata_props` tract keeps as `onnx.metadata_props.KEY`.
+fn declared_conventions(model: &InferenceModel) -> Result<Conventions, String> {
+    const PREFIX: &str = "onnx.metadata_props.";
+    let entries = model.properties.iter().filter_map(|(k, v)| {
+        let key = k.strip_prefix(PREFIX)?;
+        let value = v.try_as_plain_ram().ok()?.to_scalar::<String>().ok()?;
+        Some((key, value.as_str()))
+    });
+    Conventions::from_metadata(entries).map_err(|e| e.to_string())
 }
 
 fn shape_of(fact: &InferenceFact) -> String {
@@ -175,6 +194,8 @@ impl YoloModel {
             .with_ignore_value_info(true)
             .model_for_read(&mut std::io::Cursor::new(bytes))
             .map_err(|e| err(ModelErrorKind::Parse(format!("{e:#}"))))?;
+        let conventions =
+            declared_conventions(&model).map_err(|e| err(ModelErrorKind::Metadata(e)))?;
         let (inputs, outputs) = (model.inputs.len(), model.outputs.len());
         if inputs != 1 || outputs != 1 {
             return Err(err(ModelErrorKind::Arity { inputs, outputs }));
@@ -229,6 +250,7 @@ impl YoloModel {
         Ok(YoloModel {
             name: name.to_string(),
             head,
+            conventions,
             state,
             input,
             input_reallocations: 0,
@@ -238,6 +260,11 @@ impl YoloModel {
     /// The file the model came from.
     pub fn name(&self) -> &str {
         &self.name
+    }
+
+    /// What the file declares about its training images ([`crate::conventions`]).
+    pub fn conventions(&self) -> Conventions {
+        self.conventions
     }
 
     /// Which form of output the model gives.
@@ -373,6 +400,37 @@ mod test {
         let out = m.run(|o| o.to_vec()).unwrap();
         assert_eq!(out.len(), perception::yolo::OUTPUT_LEN);
         assert!(out.iter().enumerate().all(|(i, &x)| x == i as f32));
+    }
+
+    /// `bytes` with an ONNX `metadata_props` entry appended: field 14 of `ModelProto`, a
+    /// `StringStringEntryProto` (key 1, value 2); protobuf merges a field appended to a
+    /// message, so this is what an exporter's metadata reads as.
+    fn with_metadata(bytes: &[u8], key: &str, value: &str) -> Vec<u8> {
+        let field = |tag: u8, s: &str| {
+            assert!(s.len() < 128, "one-byte lengths only");
+            [&[tag, s.len() as u8][..], s.as_bytes()].concat()
+        };
+        let entry = [field(0x0a, key), field(0x12, value)].concat();
+        [bytes, &[0x72, entry.len() as u8], &entry].concat()
+    }
+
+    #[test]
+    fn the_file_declares_how_its_images_were_drawn() {
+        let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("yolo/testdata/boxes-form.onnx");
+        let plain = std::fs::read(path).unwrap();
+        let load = |b: &[u8]| YoloModel::from_bytes(b, "m.onnx", YoloOptions::default());
+        assert_eq!(load(&plain).unwrap().conventions(), Conventions::default());
+        let declared = with_metadata(
+            &with_metadata(&plain, "umbra.seam", "quiet"),
+            "umbra.deskew",
+            "true",
+        );
+        let c = load(&declared).unwrap().conventions();
+        assert_eq!(c.seam, Some(perception::seam::SeamRule::Quiet));
+        assert_eq!(c.deskew, Some(true));
+        let e = load(&with_metadata(&plain, "umbra.seam", "emptiest")).unwrap_err();
+        assert!(matches!(e.kind, ModelErrorKind::Metadata(_)), "{e}");
+        assert!(e.to_string().contains("umbra.seam"), "{e}");
     }
 
     #[test]

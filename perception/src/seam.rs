@@ -42,6 +42,14 @@ pub enum SeamRule {
 }
 
 impl SeamRule {
+    /// The rule's name in configuration files, dataset manifests and model metadata.
+    pub const fn name(self) -> &'static str {
+        match self {
+            SeamRule::Fixed => "fixed",
+            SeamRule::Quiet => "quiet",
+        }
+    }
+
     /// The bin the first column holds for these revolutions, newest first.
     pub fn seam<S: ScanBins + ?Sized>(self, scans: [&S; RASTER_C], cfg: &RasterConfig) -> usize {
         match self {

@@ -76,9 +76,11 @@
 //! every = 1                    # in the frame: Method B in one frame of this many
 //! mirror = false               # a second look at the mirrored raster, fused (twice the time)
 //! seam = "fixed"               # the raster's first column: "fixed" (forward) or "quiet" (the
-//!                              # longest unbroken wall); must be the model's training rule
+//!                              # longest unbroken wall); absent: what the model file declares
+//!                              # (its `umbra.seam` metadata), else "fixed"
 //! deskew = false               # boxes read where the sweep read them (models trained on
-//!                              # `umbra-sim dataset --deskew` labels); false: the middle's pose
+//!                              # `umbra-sim dataset --deskew` labels); false: the middle's pose;
+//!                              # absent: the file's `umbra.deskew`, else false
 //! ```
 
 use std::fmt;
@@ -307,10 +309,11 @@ pub struct MethodBSettings {
     /// (`perception::mirror_look`).
     pub mirror: bool,
     /// Where the raster starts (`perception::seam`): the rule the model was trained with.
-    pub seam: crate::runner::Seam,
+    /// `None`: what the model file declares (`models::conventions`), else bin 0.
+    pub seam: Option<crate::runner::Seam>,
     /// Boxes read as the sweep read them (`perception::sweep`): the rule the model's labels
-    /// were drawn with.
-    pub deskew: bool,
+    /// were drawn with. `None`: what the model file declares, else the middle's pose.
+    pub deskew: Option<bool>,
 }
 
 impl Default for MethodBSettings {
@@ -327,8 +330,8 @@ impl Default for MethodBSettings {
             schedule: crate::runner::Schedule::Auto,
             every: 1,
             mirror: false,
-            seam: crate::runner::Seam::Fixed,
-            deskew: false,
+            seam: None,
+            deskew: None,
         }
     }
 }

@@ -86,6 +86,15 @@ pub enum Seam {
     Quiet,
 }
 
+impl From<SeamRule> for Seam {
+    fn from(rule: SeamRule) -> Self {
+        match rule {
+            SeamRule::Fixed => Seam::Fixed,
+            SeamRule::Quiet => Seam::Quiet,
+        }
+    }
+}
+
 impl Seam {
     /// The rule in `perception`'s terms.
     pub fn rule(self) -> SeamRule {
@@ -227,5 +236,48 @@ fn look(
     match decoded {
         Some(Err(e)) => Err(e.to_string()),
         _ => Ok(()),
+    }
+}
+
+/// A drawing convention of Method B's (its seam, swept boxes): the configuration's when set,
+/// else what the model file declares (`models::conventions`), else `default` (files that
+/// declare nothing). A configuration that contradicts the file wins, with a warning: the
+/// model then reads images drawn unlike its training's.
+pub fn follow_model<T: PartialEq + core::fmt::Debug + Copy>(
+    what: &str,
+    configured: Option<T>,
+    declared: Option<T>,
+    default: T,
+) -> T {
+    match (configured, declared) {
+        (Some(c), Some(d)) if c != d => {
+            log::warn!(
+                "[method_b] {what} = {c:?} overrides the model's own {d:?}: its images are then \
+                 drawn unlike its training's"
+            );
+            c
+        }
+        (Some(c), _) => c,
+        (None, Some(d)) => d,
+        (None, None) => default,
+    }
+}
+
+#[cfg(test)]
+mod test {
+    use super::*;
+
+    #[test]
+    fn the_model_file_decides_unless_the_configuration_does() {
+        let q = Some(Seam::Quiet);
+        assert_eq!(follow_model("seam", None, None, Seam::Fixed), Seam::Fixed);
+        assert_eq!(follow_model("seam", None, q, Seam::Fixed), Seam::Quiet);
+        assert_eq!(
+            follow_model("seam", Some(Seam::Fixed), q, Seam::Fixed),
+            Seam::Fixed
+        );
+        assert!(follow_model("deskew", Some(true), None, false));
+        assert_eq!(Seam::from(SeamRule::Quiet).rule(), SeamRule::Quiet);
+        assert_eq!(Seam::from(SeamRule::Fixed), Seam::Fixed);
     }
 }
