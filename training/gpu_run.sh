@@ -18,7 +18,10 @@
 # seconds from the start after which training is interrupted, so the weights saved at the last
 # epoch still come back inside the call's 600 s), INIT (checkpoints/continue.pt, relative to
 # training/), and the data's mix: VARIED (0), ROUND (0), OFFICE (0), PEOPLE (0), CLUTTER (6),
-# the `umbra-sim dataset` options of the same names (`--round-tables`, `--office-chairs`).
+# the `umbra-sim dataset` options of the same names (`--round-tables`, `--office-chairs`),
+# KINDS (rect,tworooms), FRAMES (4), and how the images are drawn: SEAM (fixed; quiet) and
+# DESKEW (0; 1: swept labels). The set's dataset.json comes back with the weights: export with
+# `training/export.py --seam S --deskew true|false` as it says, so the files declare it.
 # Run locally on CPU with e.g. `SCENARIOS=40 HOURS=0.005 DEVICE=cpu PY=.venv/bin/python
 # OUT=/tmp/gpu-out bash training/gpu_run.sh` to check it before spending device time.
 set -euo pipefail
@@ -37,6 +40,12 @@ ROUND=${ROUND:-0}
 OFFICE=${OFFICE:-0}
 PEOPLE=${PEOPLE:-0}
 CLUTTER=${CLUTTER:-6}
+KINDS=${KINDS:-rect,tworooms}
+FRAMES=${FRAMES:-4}
+SEAM=${SEAM:-fixed}
+DESKEW=${DESKEW:-0}
+DRAW=(--seam "$SEAM")
+[ "$DESKEW" = 1 ] && DRAW+=(--deskew)
 DATA=${DATA:-/tmp/umbra-gpu-data}
 : "${OUT:?OUT must name a folder for the results}"
 mkdir -p "$OUT"
@@ -55,10 +64,11 @@ shm_kb=$(df -k --output=avail /dev/shm | tail -1)
 LIMIT=${LIMIT:-560}
 t0=$(date +%s)
 rm -rf "$DATA"
-.gpu/umbra-sim dataset --out "$DATA" --scenarios "$SCENARIOS" --frames 4 --seed "$SEED" \
-    --kinds rect,tworooms --clutter "$CLUTTER" --varied "$VARIED" --round-tables "$ROUND" \
-    --office-chairs "$OFFICE" --people "$PEOPLE" --no-method-a --no-recordings --pictures 0 \
-    >"$OUT/dataset.log"
+.gpu/umbra-sim dataset --out "$DATA" --scenarios "$SCENARIOS" --frames "$FRAMES" \
+    --seed "$SEED" --kinds "$KINDS" --clutter "$CLUTTER" --varied "$VARIED" \
+    --round-tables "$ROUND" --office-chairs "$OFFICE" --people "$PEOPLE" "${DRAW[@]}" \
+    --no-method-a --no-recordings --pictures 0 >"$OUT/dataset.log"
+cp "$DATA/dataset.json" "$OUT/dataset.json"
 echo "dataset: $(ls "$DATA/images/train" | wc -l) train images in $(( $(date +%s) - t0 )) s"
 
 cd training

@@ -530,23 +530,11 @@ fn load_method_b(
             _ => "in the frame",
         }
     );
-    let declared = model.conventions();
-    let seam = runner::follow_model(
-        "seam",
-        cfg.method_b.seam,
-        declared.seam.map(runner::Seam::from),
-        runner::Seam::Fixed,
-    );
-    let deskew = runner::follow_model("deskew", cfg.method_b.deskew, declared.deskew, false);
-    log::info!(
-        "Method B reads {}: seam {}, boxes placed {}",
+    let (seam, deskew) = runner::drawing(
         model.name(),
-        seam.rule().name(),
-        if deskew {
-            "where the sweep read them"
-        } else {
-            "from the revolution's middle"
-        }
+        model.conventions(),
+        cfg.method_b.seam,
+        cfg.method_b.deskew,
     );
     Ok(Some(MethodBSetup {
         model: Box::new(model),

@@ -437,12 +437,10 @@ pub fn generate(
         })
         .collect();
     let manifest = json!({
-        "seed": cfg.seed,
-        "scenarios": cfg.scenarios,
-        "frames_per_scenario": cfg.frames,
+        "seed": cfg.seed, "scenarios": cfg.scenarios, "frames_per_scenario": cfg.frames,
         "raster_max_range_m": cfg.raster.max_range_m,
-        "seam": cfg.seam.name(),
-        "deskew": cfg.deskew,
+        // How the images and labels were drawn (`training/export.py --data` reads them).
+        "seam": cfg.seam.name(), "deskew": cfg.deskew,
         "splits": {"train": split_of.iter().filter(|s| **s == Split::Train).count(),
                    "val": split_of.iter().filter(|s| **s == Split::Val).count(),
                    "test": split_of.iter().filter(|s| **s == Split::Test).count()},

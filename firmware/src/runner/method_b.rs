@@ -239,6 +239,28 @@ fn look(
     }
 }
 
+/// The seam and box placement Method B draws with for the model `name`: `[method_b] seam` and
+/// `deskew` where set, else what the file declares ([`follow_model`]); said once in the log.
+pub fn drawing(
+    name: &str,
+    declared: models::conventions::Conventions,
+    seam: Option<Seam>,
+    deskew: Option<bool>,
+) -> (Seam, bool) {
+    let seam = follow_model("seam", seam, declared.seam.map(Seam::from), Seam::Fixed);
+    let deskew = follow_model("deskew", deskew, declared.deskew, false);
+    let placed = if deskew {
+        "where the sweep read them"
+    } else {
+        "from the revolution's middle"
+    };
+    log::info!(
+        "Method B reads {name}: seam {}, boxes placed {placed}",
+        seam.rule().name()
+    );
+    (seam, deskew)
+}
+
 /// A drawing convention of Method B's (its seam, swept boxes): the configuration's when set,
 /// else what the model file declares (`models::conventions`), else `default` (files that
 /// declare nothing). A configuration that contradicts the file wins, with a warning: the

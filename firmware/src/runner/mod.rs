@@ -34,7 +34,7 @@ use perception::tracks::TrackConfig;
 
 pub use b_worker::B_WORKER_JOB_BYTES;
 pub use history::{METHOD_B_HISTORY, ScanHistory};
-pub use method_b::{MethodBScratch, MethodBSetup, Network, Schedule, Seam, follow_model};
+pub use method_b::{MethodBScratch, MethodBSetup, Network, Schedule, Seam, drawing, follow_model};
 pub use summary::Summary;
 
 use crate::deadline::{Budgets, PowerVerdict};
