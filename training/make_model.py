@@ -331,15 +331,16 @@ def main() -> None:
     info["calib"] = str(calib)
     if "export" in stages:
         best = Path(info.get("best") or Path(info["weights"]) / "best.pt")
+        # Both files declare how the sets were drawn (`export.py --seam --deskew`).
+        drawn = ["--seam", a.seam, "--deskew", str(a.deskew).lower()]
         sh([sys.executable, HERE / "export.py", "--weights", best, "--out", MODELS, "--calib",
-            calib, "--calib-images", "256", "--seam", a.seam, "--deskew", str(a.deskew).lower()])
+            calib, "--calib-images", "256", *drawn])
         if info.get("int8_weights"):
             # The int8 file from its own (quantisation-aware) weights, calibrated on the
             # images its fine-tuning measured its ranges on; the fp32 file stays `best`'s.
             tmp = work / "int8-export"
             sh([sys.executable, HERE / "export.py", "--weights", info["int8_weights"], "--out",
-                tmp, "--calib", calib, "--calib-images", "256", "--seam", a.seam,
-                "--deskew", str(a.deskew).lower()])
+                tmp, "--calib", calib, "--calib-images", "256", *drawn])
             shutil.copy(tmp / "umbra-yolov8n-int8.onnx", MODELS / "umbra-yolov8n-int8.onnx")
         shutil.copy(best, MODELS / "umbra-yolov8n.pt")
     if "eval" in stages:
