@@ -19,6 +19,9 @@ environment, `.venv/bin/python training/test_training.py DATASET/data.yaml`).
 * the drawing conventions (`export.declare`): a file declares its seam and swept labels once
   each, as the runtime reads them (`models/src/conventions.rs`), and a dataset's manifest
   gives them (`export.conventions_of`).
+* the report model's fit (`fit_report_model.py`): a track-frame off every piece is a phantom,
+  one on a piece while it stands there is not, door frames are left out; the weights written
+  for raw features give the probabilities of the standardised fit.
 """
 
 import shutil
@@ -210,6 +213,40 @@ def test_conventions_declared() -> None:
     (tmp / "dataset.json").write_text(json.dumps({"seam": "quiet", "deskew": True}))
     assert conventions_of(tmp) == ("quiet", True)
 
+
+def test_report_model_fit() -> None:
+    from fit_report_model import fit, prob, raw_weights, read_run, rust
+
+    run = Path(tempfile.mkdtemp())
+    (run / "truth.txt").write_text(
+        "run\nfurniture 0 (piece 0): box solid at (1.00, 0.00), frames 0..end, 50 returns, "
+        "footprint (0.8, -0.2) (1.2, -0.2) (1.2, 0.2) (0.8, 0.2)\n")
+    names = ["score", "rate"]
+    (run / "tracks.txt").write_text(
+        "# frame id class x y source score rate\n"
+        "5 1 box 1.100 0.100 B 0.9 1.0\n"      # on the piece
+        "5 2 box 1.450 0.000 B 0.4 0.5\n"      # 0.25 m off its edge: still on it
+        "5 3 chair 2.000 1.000 B 0.3 0.4\n"    # off every piece: a phantom
+        "5 4 door_frame 3.000 0.000 B 0.5 1.0\n")
+    got_names, x, y = read_run(run)
+    assert got_names == names and y.tolist() == [0, 0, 1], (got_names, y)
+    assert x.shape == (3, 2)
+    rng = np.random.default_rng(0)
+    xs = rng.normal(size=(400, 2)) * [0.2, 3.0] + [0.6, 10.0]
+    ys = (xs[:, 0] + 0.1 * rng.normal(size=400) < 0.55).astype(float)
+    w, b, mean, scale = fit(xs, ys, 1.0)
+    rw, rb = raw_weights(w, b, mean, scale)
+    p_std = 1.0 / (1.0 + np.exp(-(((xs - mean) / scale) @ w + b)))
+    assert np.allclose(prob(xs, rw, rb), p_std, atol=1e-9)
+    assert rw[0] < 0, "a low score must mean a phantom"
+    text = rust(rw, rb, 0.5, 50, names, "test")
+    assert "// score" in text and "threshold: 0.5" in text and "max_hits: 50" in text
+    assert ".e" not in text
+
+
+if __name__ == "__main__":
+    test_report_model_fit()
+    test_conventions_declared()
 
 if __name__ == "__main__":
     test_conventions_declared()

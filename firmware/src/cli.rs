@@ -171,6 +171,10 @@ pub struct Common {
     /// objects labelled with class and id, doors and people, redrawn in place.
     #[arg(long)]
     pub view: bool,
+    /// Write each frame's tracks that earned a report, with the features the report model
+    /// reads, to this file (world model on; for `training/fit_report_model.py`).
+    #[arg(long, value_name = "PATH")]
+    pub track_log: Option<PathBuf>,
 }
 
 /// `umbra run`.

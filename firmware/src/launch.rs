@@ -391,6 +391,7 @@ fn run_loop(
         method_a: cfg.method_a.enabled.then(|| (cfg.method_a(), mount)),
         method_b,
         world: cfg.world.enabled.then(|| cfg.world.tracks(b_runs)),
+        track_log: common.track_log.clone(),
     };
     let scheduling = crate::realtime::apply(cfg.runtime.scheduling, cfg.runtime.fifo_priority);
     log::info!("frame loop: {scheduling}");

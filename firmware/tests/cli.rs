@@ -646,6 +646,45 @@ fn replay_of_a_simulated_recording_finds_its_true_objects() {
     );
 }
 
+#[test]
+fn the_track_log_holds_every_reported_object_with_its_report_features() {
+    let dir = recordings("track-log-ds", 1, 60, 12);
+    let log = tmp("tracks.txt");
+    let (frames, _) = replay_recording_with(
+        &dir.join("recordings/s0000"),
+        &tmp("track-log.jsonl"),
+        &["--track-log", log.to_str().unwrap()],
+    );
+    let text = std::fs::read_to_string(&log).unwrap();
+    let mut lines = text.lines();
+    let header: Vec<&str> = lines.next().unwrap().split_whitespace().collect();
+    let names = perception::tracks::FEATURE_NAMES;
+    assert_eq!(header.len(), 7 + names.len(), "{header:?}");
+    assert_eq!(&header[7..], &names[..]);
+    let mut logged = std::collections::HashSet::new();
+    for l in lines {
+        let c: Vec<&str> = l.split_whitespace().collect();
+        assert_eq!(c.len(), 6 + names.len(), "{l}");
+        assert!(
+            c[6..]
+                .iter()
+                .all(|v| v.parse::<f32>().is_ok_and(f32::is_finite)),
+            "{l}"
+        );
+        logged.insert((c[0].parse::<u64>().unwrap(), c[1].parse::<u64>().unwrap()));
+    }
+    // Every object a line reports earned its report that frame, so it is in the log.
+    let mut reported = 0;
+    for f in &frames {
+        for o in f["objects"].as_array().unwrap() {
+            let key = (f["frame"].as_u64().unwrap(), o["id"].as_u64().unwrap());
+            assert!(logged.contains(&key), "{key:?} reported but not logged");
+            reported += 1;
+        }
+    }
+    assert!(reported > 20, "only {reported} objects reported");
+}
+
 /// The deadline table that a run prints at its end (from `| stage` to the power line).
 fn table_of(stderr: &str) -> String {
     let start = stderr.find("| stage |").expect("a deadline table");

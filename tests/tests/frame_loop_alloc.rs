@@ -96,6 +96,7 @@ fn per_frame_from(
         sinks.push(Box::new(VizSink::new(link)));
     }
     let opts = RunOptions {
+        track_log: None,
         frames: Some(FRAMES),
         seconds: None,
         seconds_clock: SecondsClock::Wall,

@@ -149,6 +149,11 @@ fn buffers_in_code() -> Vec<(&'static str, usize, usize)> {
             size_of::<perception::calibration::Calibration>(),
         ),
         (
+            "size_of::<perception::tracks::ReportModel>()",
+            1,
+            size_of::<perception::tracks::ReportModel>(),
+        ),
+        (
             "perception::tracks::MAX_WALKERS",
             perception::tracks::MAX_WALKERS,
             size_of::<perception::tracks::Walker>(),

@@ -425,6 +425,9 @@ impl Config {
                 l.stale_after_ms
             ));
         }
+        if let Some(v) = self.world.phantom_threshold {
+            within("world", "phantom_threshold", v, 0.0, 1.0)?;
+        }
         if let Some(v) = self.world.min_likelihood {
             within("world", "min_likelihood", v, 0.0, 1.0)?;
         }
@@ -595,6 +598,21 @@ mod test {
             0.6
         );
         assert_eq!(Config::default().world.tracks(true).door_hold_hits, 20);
+        // The report model: off unless a threshold below 1 is set.
+        let model = models::report_model::REPORT_MODEL;
+        assert!(model.is_some(), "no report model compiled in");
+        assert_eq!(Config::default().world.tracks(true).report_model, None);
+        let off: Config = toml::from_str("[world]\nphantom_threshold = 1.0\n").unwrap();
+        assert_eq!(off.world.tracks(true).report_model, None);
+        let set: Config = toml::from_str("[world]\nphantom_threshold = 0.7\n").unwrap();
+        let m = set.world.tracks(true).report_model.expect("on at 0.7");
+        assert_eq!((m.threshold, m.weights), (0.7, model.unwrap().weights));
+        let bad: Config = toml::from_str("[world]\nphantom_threshold = -0.1\n").unwrap();
+        assert!(
+            bad.validate()
+                .unwrap_err()
+                .contains("world.phantom_threshold")
+        );
         assert_eq!(Config::default().world.tracks(true).appeared_settle_s, 3.0);
         let w: Config = toml::from_str("[world]\nappeared_settle_s = 0\n").unwrap();
         assert_eq!(w.world.tracks(true).appeared_settle_s, 0.0);

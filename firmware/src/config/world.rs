@@ -31,6 +31,13 @@ pub struct WorldSettings {
     /// The same for desks alone (the larger of the two applies to them): on by default, since
     /// on the tuning and the held-out runs it cost no desk (docs/world.md).
     pub desk_min_likelihood: f32,
+    /// Furniture the report model compiled in (`models::report_model`, fitted on the tuning
+    /// runs' track logs with both methods running) finds a phantom with at least this
+    /// probability is not reported (`perception::tracks::Track::held_back`). Unset or 1 (the
+    /// default): off. 0.4, the threshold chosen on the tuning runs, trades recall for
+    /// precision: held out it cut phantoms by 7–21 % and cost 4 of the annex's 122 pieces
+    /// (docs/world.md, 41st session), so it is not on by default.
+    pub phantom_threshold: Option<f32>,
     /// A door frame seen in this many frames is a doorway of the map: the methods' silence no
     /// longer speaks against it, only rays ending in its middle (shut) or passing where its
     /// jambs should be (`perception::tracks::TrackConfig::door_hold_hits`); only one in the
@@ -70,6 +77,7 @@ impl Default for WorldSettings {
             legs: false,
             min_likelihood: None,
             desk_min_likelihood: 0.6,
+            phantom_threshold: None,
             door_hold_hits: 20,
             appeared_settle_s: 3.0,
             miss_min_returns: 2,
@@ -101,6 +109,15 @@ impl WorldSettings {
         if self.desk_min_likelihood.is_finite() {
             c.min_desk_likelihood = self.desk_min_likelihood.clamp(0.0, 1.0);
         }
+        c.report_model = match self.phantom_threshold {
+            Some(t) if t.is_finite() && t < 1.0 => {
+                models::report_model::REPORT_MODEL.map(|m| perception::tracks::ReportModel {
+                    threshold: t.max(0.0),
+                    ..m
+                })
+            }
+            _ => None,
+        };
         c.door_hold_hits = self.door_hold_hits;
         if self.appeared_settle_s.is_finite() {
             c.appeared_settle_s = self.appeared_settle_s.max(0.0);

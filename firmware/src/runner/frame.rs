@@ -87,6 +87,7 @@ pub(super) struct FrameState {
     wall_map: Box<WallMap>,
     /// While recording: the LiDAR bytes read since the recorder last took them.
     recording: Option<RecordingInput>,
+    pub(super) track_log: super::track_log::TrackLog,
 }
 
 /// LiDAR bytes waiting for the recorder.
@@ -132,6 +133,7 @@ impl FrameState {
                 raw: Box::new(heapless::Vec::new()),
                 dropped: 0,
             }),
+            track_log: Default::default(),
         }
     }
 
@@ -442,8 +444,9 @@ impl<S: RevolutionStream> FrameLoop<'_, S> {
                 if t.too_narrow() || t.looks_round() {
                     continue;
                 }
-                // Furniture seen only in the ways the methods are mostly wrong.
-                if t.unlikely(cfg) {
+                st.track_log.write(frame, t);
+                // Seen only in the ways the methods are mostly wrong, or a phantom by the model.
+                if t.held_back(frame, cfg) {
                     continue;
                 }
                 let o = ObjectOut::track(t);

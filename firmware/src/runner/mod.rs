@@ -22,6 +22,7 @@ mod frame;
 mod history;
 mod method_b;
 mod summary;
+mod track_log;
 
 use std::io;
 use std::sync::Arc;
@@ -86,6 +87,8 @@ pub struct RunOptions {
     pub method_b: Option<MethodBSetup>,
     /// The world model's settings; `None`: off (`objects` are the frame's detections).
     pub world: Option<TrackConfig>,
+    /// Write each frame's reportable tracks and their report features here (`--track-log`).
+    pub track_log: Option<std::path::PathBuf>,
 }
 
 /// Method B's stage budget on its own thread, in deadlines (at least).
@@ -100,6 +103,7 @@ pub fn run<S: RevolutionStream>(
     let start = Instant::now();
     let records = opts.sinks.iter().any(|s| s.records_input());
     let mut st = FrameState::new(records);
+    st.track_log = track_log::TrackLog::create(opts.track_log.as_deref())?;
     // The LiDAR's pose on the robot, from whichever method has it.
     let mount = match (&opts.method_a, &opts.method_b) {
         (Some((_, m)), _) => *m,

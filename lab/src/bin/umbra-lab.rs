@@ -208,6 +208,10 @@ enum Command {
         /// (repeatable; for ablations).
         #[arg(long = "world-set", value_name = "KEY=VALUE")]
         world_set: Vec<String>,
+        /// Keep each world-on replay's track log (`tracks.txt` beside its output lines), for
+        /// `training/fit_report_model.py`.
+        #[arg(long)]
+        track_logs: bool,
     },
 }
 
@@ -512,6 +516,7 @@ fn run(cli: Cli) -> Result<(), String> {
             json,
             plot,
             world_set,
+            track_logs,
         } => {
             use lab::world_eval::{EvalConfig, Family, evaluate, report};
             let umbra = match umbra {
@@ -550,6 +555,7 @@ fn run(cli: Cli) -> Result<(), String> {
                     .iter()
                     .map(|s| s.replacen('=', " = ", 1))
                     .collect(),
+                track_logs,
             };
             let pb = bar(runs * cfg.families.len(), "runs");
             let out = evaluate(&cfg, |name| {

@@ -65,6 +65,8 @@ pub struct EvalConfig {
     pub dir: PathBuf,
     /// Extra `[world]` lines for the world-on replays (`key = value`), for ablations.
     pub world_set: Vec<String>,
+    /// Have the world-on replays write their track logs (`tracks.txt`, `umbra --track-log`).
+    pub track_logs: bool,
 }
 
 /// One family × world setting's result.
@@ -105,13 +107,15 @@ pub fn generate(family: Family, seed: u64, i: usize, seconds: f64) -> GeneratedR
 /// the binary and does not link it): under it no replayed frame is degraded for time.
 const MAX_DEADLINE_MS: u32 = 10_000;
 
-/// Writes `run` to `dir` and replays it through `umbra` with the world model `world`.
+/// Writes `run` to `dir` and replays it through `umbra` with the world model `world`;
+/// `track_log`: with the world model on, `umbra` writes its track log to `dir/tracks.txt`.
 pub fn replay(
     umbra: &Path,
     dir: &Path,
     run: &GeneratedRun,
     world: bool,
     world_set: &[String],
+    track_log: bool,
 ) -> Result<Vec<Line>, String> {
     std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
     let write = |name: &str, bytes: &[u8]| {
@@ -142,6 +146,17 @@ pub fn replay(
         .arg(run.lidar.cli_name())
         .args(["--jsonl", "-", "--quiet", "--config"])
         .arg(&config)
+        .args(
+            (world && track_log)
+                .then(|| {
+                    [
+                        "--track-log".into(),
+                        dir.join("tracks.txt").into_os_string(),
+                    ]
+                })
+                .into_iter()
+                .flatten(),
+        )
         .output()
         .map_err(|e| format!("{}: {e}", umbra.display()))?;
     if !out.status.success() {
@@ -193,7 +208,14 @@ pub fn evaluate(cfg: &EvalConfig, mut progress: impl FnMut(&str)) -> Result<Vec<
             std::fs::write(dir.join("truth.txt"), describe(&run.truth))
                 .map_err(|e| e.to_string())?;
             for o in &mut per {
-                let lines = replay(&cfg.umbra, &dir, &run, o.world, &cfg.world_set)?;
+                let lines = replay(
+                    &cfg.umbra,
+                    &dir,
+                    &run,
+                    o.world,
+                    &cfg.world_set,
+                    cfg.track_logs,
+                )?;
                 let on = if o.world { "on" } else { "off" };
                 picture::write(
                     &dir.join(format!("map-world-{on}.png")),

@@ -54,6 +54,7 @@ impl Tracks {
                 t.existence = t.existence.max(gone.existence);
                 t.hits = t.hits.saturating_add(gone.hits);
                 t.p_sum += gone.p_sum;
+                t.tally.absorb(&gone.tally);
                 t.views = t.views.max(gone.views);
                 t.first_seen = t.first_seen.min(gone.first_seen);
                 t.last_seen = t.last_seen.max(gone.last_seen);

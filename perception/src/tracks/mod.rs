@@ -39,12 +39,12 @@
 //! 6. **Likelihood:** each observation's calibrated probability ([`TrackConfig::calibration`])
 //!    is summed; furniture whose mean is below [`TrackConfig::min_likelihood`] (desks:
 //!    [`TrackConfig::min_desk_likelihood`]) is not reported ([`Track::unlikely`],
-//!    `likelihood.rs`).
+//!    `likelihood.rs`), nor what the report model finds a phantom (`report_model.rs`).
 //!
 //! Files: `association.rs` (which observation updates which track), `merge.rs` (one object
 //! seen twice), `negative.rs` (what the rays say), `walkers.rs` (the leg detector's tracks),
 //! `door_marks.rs` (the map's walls and door frames), `outline_marks.rs` (a box's shape),
-//! `report.rs` (when reported, when deleted), `likelihood.rs`, `stats.rs` (the counters).
+//! `report.rs` (when reported, when deleted), `likelihood.rs`, `report_model.rs`, `stats.rs`.
 
 use heapless::Vec;
 
@@ -57,20 +57,24 @@ use crate::motion::{Motion, MotionConfig};
 use crate::outline_average::AveragedOutline;
 use crate::sight::BINS;
 use association::{cheapest, class_cost};
+use belief::class_radius;
 pub use outline_marks::{
     AVERAGED_ROUND_MAJORITY, AVERAGED_ROUND_VIEWS, OUTLINE_SLOTS, averaged_vote,
 };
 pub use report::{DESK_BESIDE_M, DESK_VIEW_SPAN_M};
 use report::{desk_beside, earns_report};
+pub use report_model::{FEATURE_NAMES, REPORT_FEATURES, ReportModel, Tally};
 pub use stats::TrackStats;
 
 mod association;
+mod belief;
 mod door_marks;
 mod likelihood;
 mod merge;
 mod negative;
 mod outline_marks;
 mod report;
+mod report_model;
 mod stats;
 mod walkers;
 
@@ -143,6 +147,8 @@ pub struct TrackConfig {
     pub min_likelihood: f32,
     /// The same for desks alone (the larger of the two applies to them).
     pub min_desk_likelihood: f32,
+    /// Furniture it finds a phantom is not reported ([`Track::held_back`]); `None`: off.
+    pub report_model: Option<ReportModel>,
     /// A door frame with this many hits is a doorway of the map, as one the map's walls
     /// showed is ([`Track::anchored`]): only what the rays show of it (shut, or no jambs
     /// where they should be) speaks against it, not the methods' silence. A doorway does not
@@ -179,6 +185,7 @@ impl Default for TrackConfig {
             calibration: Calibration::IDENTITY,
             min_likelihood: 0.0,
             min_desk_likelihood: 0.0,
+            report_model: None,
             door_hold_hits: 0,
             appeared_settle_s: 0.0,
         }
@@ -257,53 +264,8 @@ pub struct Track {
     pub first_view: Point2,
     /// How far from [`Track::first_view`] the LiDAR has seen it since, at most, m.
     pub view_span: f32,
-}
-
-impl Track {
-    /// The most likely class.
-    pub fn class(&self) -> ObjectClass {
-        let mut best = 0;
-        for k in 1..4 {
-            if self.class_evidence[k] > self.class_evidence[best] {
-                best = k;
-            }
-        }
-        ObjectClass::ALL[best]
-    }
-
-    /// The class's share of the evidence, in [0, 1].
-    pub fn class_score(&self) -> f32 {
-        let total: f32 = self.class_evidence.iter().sum();
-        if total > 0.0 {
-            self.class_evidence[self.class() as usize] / total
-        } else {
-            0.0
-        }
-    }
-
-    /// Which methods have seen it.
-    pub fn evidence(&self) -> Evidence {
-        match (self.seen_a, self.seen_b) {
-            (true, true) => Evidence::AB,
-            (false, true) => Evidence::B,
-            _ => Evidence::A,
-        }
-    }
-
-    /// Radius of the footprint negative evidence looks across, m (a desk's legs span ~1.8 m).
-    fn radius(&self) -> f32 {
-        class_radius(self.class())
-    }
-}
-
-/// Footprint radius of a class, m.
-fn class_radius(c: ObjectClass) -> f32 {
-    match c {
-        ObjectClass::Chair => 0.3,
-        ObjectClass::Box => 0.35,
-        ObjectClass::Desk => 0.9,
-        ObjectClass::DoorFrame => 0.5,
-    }
+    /// What its observations and misses were ([`Tally`]): what the report model reads.
+    pub tally: Tally,
 }
 
 /// The track table.
@@ -510,6 +472,7 @@ impl Tracks {
                 p_sum: 0.0,
                 first_view: sensor,
                 view_span: 0.0,
+                tally: Tally::default(),
             };
             let beside = o.class == ObjectClass::Desk && desk_beside(&self.tracks, o.centre, None);
             Self::hit(&mut t, o, frame, stamp_s, sensor, beside, cfg);
@@ -552,6 +515,8 @@ impl Tracks {
         t.weight = total.min(cfg.max_weight);
         t.class_evidence[o.class as usize] += o.score.clamp(0.0, 1.0);
         t.p_sum += p;
+        let (range, off) = (sensor.distance(o.centre), t.centre.distance(o.centre));
+        t.tally.observe(o.evidence, p, o.score, range, off);
         t.existence = (t.existence + cfg.hit_gain * w).min(cfg.existence_cap);
         t.hits = t.hits.saturating_add(1);
         t.views = t.views.saturating_add(1);
@@ -727,6 +692,86 @@ mod test {
             (m.likelihood() - (21.0 / 102.0 + 91.0 / 102.0) / 2.0).abs() < 1e-3,
             "{m:?}"
         );
+    }
+
+    #[test]
+    fn the_report_model_holds_back_what_it_finds_a_phantom() {
+        let far = ranges(4.0);
+        let run = |o: FrameObject, cfg: &TrackConfig| {
+            let mut t = Tracks::new();
+            for f in 0..12 {
+                step(&mut t, f, &[o], &Pose2::IDENTITY, &far, cfg);
+            }
+            let first = t.confirmed().next().copied();
+            (first, t)
+        };
+        // A model that reads only the detections' mean score: a phantom below 0.5.
+        let mut weights = [0.0; REPORT_FEATURES];
+        let score = FEATURE_NAMES.iter().position(|n| *n == "score").unwrap();
+        weights[score] = -20.0;
+        let model = ReportModel {
+            weights,
+            bias: 10.0,
+            threshold: 0.5,
+            max_hits: 100,
+        };
+        let cfg = TrackConfig {
+            report_model: Some(model),
+            ..quick()
+        };
+        let (low, _) = run(obs(ObjectClass::Box, 2.0, 0.0, 0.3, Evidence::B), &cfg);
+        let low = low.expect("earned its report");
+        let f = low.report_features(11);
+        assert_eq!(
+            (f[1], f[5], f[12]),
+            (1.0, 1.0, 1.0),
+            "box, seen by B, all B: {f:?}"
+        );
+        assert!(
+            (f[score] - 0.3).abs() < 1e-6 && (f[8] - 1.0).abs() < 1e-6,
+            "{f:?}"
+        );
+        assert!(model.phantom_probability(&f) > 0.9);
+        assert!(low.held_back(11, &cfg) && !low.unlikely(&cfg));
+        let (high, _) = run(obs(ObjectClass::Box, 2.0, 0.0, 0.9, Evidence::B), &cfg);
+        assert!(!high.expect("earned its report").held_back(11, &cfg));
+        // Door frames are the map's walls' to judge; no model, nothing held back.
+        let (door, _) = run(
+            obs(ObjectClass::DoorFrame, 2.0, 0.0, 0.3, Evidence::B),
+            &cfg,
+        );
+        assert!(!door.expect("earned its report").held_back(11, &cfg));
+        let off = TrackConfig {
+            report_model: None,
+            ..cfg
+        };
+        assert!(!low.held_back(11, &off));
+        // Nor one seen in more frames than the model judges.
+        let few = TrackConfig {
+            report_model: Some(ReportModel {
+                max_hits: low.hits,
+                ..model
+            }),
+            ..cfg
+        };
+        assert!(!low.held_back(11, &few));
+        // A feature that is not a number adds nothing.
+        let mut bad = f;
+        bad[score] = f32::NAN;
+        assert!((model.phantom_probability(&bad) - 1.0 / (1.0 + libm::expf(-10.0))).abs() < 1e-6);
+        // Its place seen empty (the rays at 4 m pass through it) is tallied, not as a miss.
+        let (_, mut t) = run(obs(ObjectClass::Box, 2.0, 0.0, 0.9, Evidence::B), &cfg);
+        for f in 12..14 {
+            step(&mut t, f, &[], &Pose2::IDENTITY, &far, &cfg);
+        }
+        let gone = t.tracks.first().expect("kept once reported");
+        assert_eq!(
+            (gone.tally.empties, gone.tally.misses),
+            (2, 0),
+            "{:?}",
+            gone.tally
+        );
+        assert_eq!(gone.tally.hits_by, [0, 12, 0]);
     }
 
     #[test]

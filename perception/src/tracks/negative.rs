@@ -54,7 +54,8 @@ pub(super) fn unobserved(
     cfg: &TrackConfig,
 ) {
     let looked_for = looked.for_track(t);
-    let (loss, in_view) = if t.held_door(cfg) {
+    // (existence lost, in view, the place seen empty)
+    let (loss, in_view, empty) = if t.held_door(cfg) {
         // An opening in a wall: seen through is what it looks like.
         let jambs = if t.width_m > 0.0 {
             0.5 * t.width_m
@@ -62,11 +63,11 @@ pub(super) fn unobserved(
             t.radius()
         };
         match doorway_view(t.centre, jambs, lidar, ranges, cfg.max_range_m) {
-            DoorView::Closed => (cfg.miss_loss, true),
-            DoorView::NoJambs => (cfg.free_loss, true),
+            DoorView::Closed => (cfg.miss_loss, true, false),
+            DoorView::NoJambs => (cfg.free_loss, true, true),
             // In view all the same: a one-method door must be seen at its rate.
-            DoorView::Open => (0.0, looked_for),
-            DoorView::Hidden => (0.0, false),
+            DoorView::Open => (0.0, looked_for, false),
+            DoorView::Hidden => (0.0, false, false),
         }
     } else {
         // A door frame not yet anchored in the map's walls is an opening all the same: rays
@@ -77,16 +78,19 @@ pub(super) fn unobserved(
             footprint_view
         };
         match look(t.centre, t.radius(), lidar, ranges, cfg.max_range_m) {
-            View::Empty => (cfg.free_loss, true),
+            View::Empty => (cfg.free_loss, true, true),
             // Too few returns for any method to have found it: not a miss — unless it appeared
             // where the floor had been seen empty (legs that stopped, like as not, not a piece
             // of furniture the LiDAR barely reaches).
             View::Plain(n) if looked_for && (n >= cfg.miss_min_returns || t.born_on_free) => {
-                (cfg.miss_loss, true)
+                (cfg.miss_loss, true, false)
             }
-            View::Plain(_) | View::Hidden => (0.0, false),
+            View::Plain(_) | View::Hidden => (0.0, false, false),
         }
     };
+    if loss > 0.0 {
+        t.tally.unobserved(empty);
+    }
     if in_view {
         t.views = t.views.saturating_add(1);
     }
