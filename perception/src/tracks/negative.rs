@@ -38,6 +38,17 @@ impl Looked {
     }
 }
 
+/// What a frame's rays said of a track it did not observe.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Said {
+    /// Nothing: out of view, hidden, too few returns, or a doorway seen open.
+    Nothing,
+    /// In plain view and not detected (or a doorway seen shut): `miss_loss`.
+    Missed,
+    /// Its place seen empty (or a doorway without its jambs): `free_loss`.
+    Empty,
+}
+
 /// Returns a revolution needs before its rays with no return count as passing through a
 /// piece's footprint (`trust_none` of [`unobserved`]; a tenth of the bins).
 pub(super) const MIN_RETURNS: usize = BINS / 10;
@@ -54,8 +65,7 @@ pub(super) fn unobserved(
     cfg: &TrackConfig,
 ) {
     let looked_for = looked.for_track(t);
-    // (existence lost, in view, the place seen empty)
-    let (loss, in_view, empty) = if t.held_door(cfg) {
+    let (said, in_view) = if t.held_door(cfg) {
         // An opening in a wall: seen through is what it looks like.
         let jambs = if t.width_m > 0.0 {
             0.5 * t.width_m
@@ -63,11 +73,11 @@ pub(super) fn unobserved(
             t.radius()
         };
         match doorway_view(t.centre, jambs, lidar, ranges, cfg.max_range_m) {
-            DoorView::Closed => (cfg.miss_loss, true, false),
-            DoorView::NoJambs => (cfg.free_loss, true, true),
+            DoorView::Closed => (Said::Missed, true),
+            DoorView::NoJambs => (Said::Empty, true),
             // In view all the same: a one-method door must be seen at its rate.
-            DoorView::Open => (0.0, looked_for, false),
-            DoorView::Hidden => (0.0, false, false),
+            DoorView::Open => (Said::Nothing, looked_for),
+            DoorView::Hidden => (Said::Nothing, false),
         }
     } else {
         // A door frame not yet anchored in the map's walls is an opening all the same: rays
@@ -78,18 +88,23 @@ pub(super) fn unobserved(
             footprint_view
         };
         match look(t.centre, t.radius(), lidar, ranges, cfg.max_range_m) {
-            View::Empty => (cfg.free_loss, true, true),
+            View::Empty => (Said::Empty, true),
             // Too few returns for any method to have found it: not a miss — unless it appeared
             // where the floor had been seen empty (legs that stopped, like as not, not a piece
             // of furniture the LiDAR barely reaches).
             View::Plain(n) if looked_for && (n >= cfg.miss_min_returns || t.born_on_free) => {
-                (cfg.miss_loss, true, false)
+                (Said::Missed, true)
             }
-            View::Plain(_) | View::Hidden => (0.0, false, false),
+            View::Plain(_) | View::Hidden => (Said::Nothing, false),
         }
     };
-    if loss > 0.0 {
-        t.tally.unobserved(empty);
+    let loss = match said {
+        Said::Missed => cfg.miss_loss,
+        Said::Empty => cfg.free_loss,
+        Said::Nothing => 0.0,
+    };
+    if said != Said::Nothing {
+        t.tally.unobserved(said == Said::Empty);
     }
     if in_view {
         t.views = t.views.saturating_add(1);
