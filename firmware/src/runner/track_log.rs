@@ -25,14 +25,17 @@ impl TrackLog {
         let Some(path) = path else {
             return Ok(TrackLog::default());
         };
-        let file = File::create(path)
-            .map_err(|e| io::Error::new(e.kind(), format!("{}: {e}", path.display())))?;
-        let mut out = BufWriter::with_capacity(BUFFER_BYTES, file);
-        write!(out, "# frame id class x y source")?;
-        for n in FEATURE_NAMES {
-            write!(out, " {n}")?;
-        }
-        writeln!(out)?;
+        let named =
+            |e: io::Error| io::Error::new(e.kind(), format!("--track-log {}: {e}", path.display()));
+        let mut out = BufWriter::with_capacity(BUFFER_BYTES, File::create(path).map_err(named)?);
+        let header = |out: &mut BufWriter<File>| -> io::Result<()> {
+            write!(out, "# frame id class x y source")?;
+            for n in FEATURE_NAMES {
+                write!(out, " {n}")?;
+            }
+            writeln!(out)
+        };
+        header(&mut out).map_err(named)?;
         Ok(TrackLog { out: Some(out) })
     }
 

@@ -137,26 +137,19 @@ pub fn replay(
         )
         .as_bytes(),
     )?;
-    let out = Command::new(umbra)
-        .arg("replay")
+    let mut cmd = Command::new(umbra);
+    cmd.arg("replay")
         .arg(&capture)
         .arg("--odom")
         .arg(&odom)
         .arg("--lidar-model")
         .arg(run.lidar.cli_name())
         .args(["--jsonl", "-", "--quiet", "--config"])
-        .arg(&config)
-        .args(
-            (world && track_log)
-                .then(|| {
-                    [
-                        "--track-log".into(),
-                        dir.join("tracks.txt").into_os_string(),
-                    ]
-                })
-                .into_iter()
-                .flatten(),
-        )
+        .arg(&config);
+    if world && track_log {
+        cmd.arg("--track-log").arg(dir.join("tracks.txt"));
+    }
+    let out = cmd
         .output()
         .map_err(|e| format!("{}: {e}", umbra.display()))?;
     if !out.status.success() {
