@@ -73,6 +73,9 @@ pub struct DatasetConfig {
     /// Labels drawn as the sweep read each footprint (`sim::labels::swept_box`), not from the
     /// pose at the middle of the revolution.
     pub deskew: bool,
+    /// Share of scenarios whose LiDAR is a worn unit (`sim::wear`: returns fading with range,
+    /// mixed pixels at depth edges); 0 leaves every scenario as it was.
+    pub worn: f64,
 }
 
 impl Default for DatasetConfig {
@@ -91,6 +94,7 @@ impl Default for DatasetConfig {
             people: 0,
             seam: SeamRule::Fixed,
             deskew: false,
+            worn: 0.0,
         }
     }
 }
@@ -185,7 +189,8 @@ pub fn simulate(
     mut on_frame: impl FnMut(&Scenario, &Frame, &[OdomSample]),
     mut on_sample: impl FnMut(&Scenario, Sample<'_>),
 ) -> Scenario {
-    let sc = scenario_config(i, &cfg.world);
+    let mut sc = scenario_config(i, &cfg.world);
+    sc.worn = cfg.worn;
     let mut scenario = Scenario::new(scenario_seed(cfg.seed, i), &sc);
     if cfg.people > 0 {
         scenario.add_people(scenario_seed(cfg.seed, i), cfg.people);

@@ -16,6 +16,7 @@ use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
 use crate::scenario::{Frame, Scenario, ScenarioConfig};
+use crate::wear::Wear;
 use crate::world::World;
 
 /// LiDAR mount relative to the robot centre (TurtleBot3 Burger).
@@ -46,6 +47,8 @@ pub struct Lds01SimConfig {
     pub far_max_m: f32,
     /// Range noise as a fraction of range above 0.5 m (≈ σ; spec ±5 % taken as ~2σ).
     pub noise_frac: f32,
+    /// A real unit's wear (fading returns, mixed pixels); none by default.
+    pub wear: Wear,
 }
 
 impl Default for Lds01SimConfig {
@@ -60,6 +63,7 @@ impl Default for Lds01SimConfig {
             far_return: 0.3,
             far_max_m: 4.2,
             noise_frac: 0.025,
+            wear: Wear::default(),
         }
     }
 }
@@ -113,6 +117,11 @@ impl LidarModel {
         }
     }
 
+    /// Its settings.
+    pub fn cfg(&self) -> &Lds01SimConfig {
+        &self.cfg
+    }
+
     fn gauss(&mut self) -> f32 {
         crate::noise::unit(&mut self.rng)
     }
@@ -120,6 +129,17 @@ impl LidarModel {
     /// The speed of the next revolution, rpm.
     pub fn draw_rpm(&mut self) -> f32 {
         (self.cfg.rpm + self.gauss() * self.cfg.rpm_jitter).clamp(60.0, 600.0)
+    }
+
+    /// Where the spot's other side looks, radians from the beam (a side drawn at random), or
+    /// `None` for a unit without mixed pixels (then nothing is drawn).
+    pub fn spot_offset(&mut self) -> Option<f32> {
+        let w = self.cfg.wear;
+        if !w.has_spot() {
+            return None;
+        }
+        let side = if self.rng.random_bool(0.5) { 1.0 } else { -1.0 };
+        Some(side * w.half_spot_deg.to_radians())
     }
 
     /// A reading that found nothing.
@@ -131,13 +151,21 @@ impl LidarModel {
         }
     }
 
-    /// A reading of a surface at true range `r` (m), incidence cosine `cos`, `reflectivity`.
-    pub fn reading(&mut self, r: f32, cos: f32, reflectivity: f32) -> RawReading {
+    /// A reading of a surface at true range `r` (m), incidence cosine `cos`, `reflectivity`;
+    /// `other`: the range the spot's other side hits ([`LidarModel::spot_offset`]), if any.
+    pub fn reading(
+        &mut self,
+        r: f32,
+        cos: f32,
+        reflectivity: f32,
+        other: Option<f32>,
+    ) -> RawReading {
         let c = &self.cfg;
         let returns = if r <= c.spec_max_m {
             let p_drop = c.dropout
                 + c.dark_dropout * f64::from(1.0 - reflectivity)
-                + c.glancing_dropout * f64::from((0.3 - cos).max(0.0) / 0.3);
+                + c.glancing_dropout * f64::from((0.3 - cos).max(0.0) / 0.3)
+                + c.wear.fade_at(r, c.spec_max_m);
             !self.rng.random_bool(p_drop.clamp(0.0, 1.0))
         } else {
             r <= c.far_max_m && self.rng.random_bool(c.far_return * f64::from(reflectivity))
@@ -145,6 +173,8 @@ impl LidarModel {
         if !returns {
             return self.miss();
         }
+        let wear = self.cfg.wear;
+        let r = wear.mix(r, other, &mut self.rng);
         let sigma = if r < 0.5 {
             0.0075
         } else {

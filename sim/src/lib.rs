@@ -17,6 +17,7 @@
 //! | `dataset`     | dataset writers: YOLO layout, Method A labels, replay recordings (feature `tools`) |
 //! | [`noise`]     | the bounded, unit-σ noise every sensor model draws from               |
 //! | `picture`     | a PNG of a scene for people to look at (feature `tools`)              |
+//! | [`wear`]      | a real unit's wear: returns fading with range, mixed pixels at depth edges |
 //! | [`wire`]      | every LiDAR model's bytes from the same simulated revolutions          |
 //! | [`corrupt`]   | a noisy serial line: bit flips, inserted and dropped bytes, with truth |
 //! | `pty`         | devices on pseudo-terminals for hardware-in-the-loop tests (feature `pty`) |
@@ -36,5 +37,6 @@ pub mod picture;
 pub mod pty;
 pub mod robot;
 pub mod scenario;
+pub mod wear;
 pub mod wire;
 pub mod world;

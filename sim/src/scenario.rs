@@ -16,6 +16,7 @@ use crate::compass::{Compass, CompassConfig};
 use crate::lds01::{LIDAR_MOUNT, Lds01SimConfig, LidarModel};
 use crate::people::{ROBOT_RADIUS_M, Walker};
 use crate::robot::{Robot, RobotConfig};
+use crate::wear::Wear;
 use crate::world::{Shape, Surface, World, WorldConfig};
 
 /// Everything a scenario needs besides its seed.
@@ -31,6 +32,10 @@ pub struct ScenarioConfig {
     pub compass: CompassConfig,
     /// Encoder/compass samples per second (0 = none; default 20, the vendor node's 50 ms).
     pub odom_hz: f32,
+    /// Share of scenarios whose LiDAR is a worn unit ([`Wear::draw`]), decided from the
+    /// scenario's seed on a salted stream of its own; 0 (the default) leaves every scenario as
+    /// it was.
+    pub worn: f64,
 }
 
 impl ScenarioConfig {
@@ -162,11 +167,17 @@ impl Scenario {
         let robot = Robot::new(&world, cfg.robot, seeds.random());
         let compass = Compass::new(&world, cfg.compass, seeds.random());
         let lidar_seed = seeds.random();
-        let lidar_cfg = if world.varied {
+        let mut lidar_cfg = if world.varied {
             cfg.lidar.varied(seeds.random())
         } else {
             cfg.lidar.clone()
         };
+        if cfg.worn > 0.0 {
+            let mut rng = ChaCha8Rng::seed_from_u64(seed ^ WEAR_SALT);
+            if rng.random_bool(cfg.worn.min(1.0)) {
+                lidar_cfg.wear = Wear::draw(rng.random());
+            }
+        }
         let lidar = LidarModel::new(lidar_cfg, lidar_seed);
         Scenario {
             start_pose: robot.pose,
@@ -262,7 +273,8 @@ impl Scenario {
                 let hit = self.nearer_person(o, angle, hit);
                 let (r, surface, reading) = match hit {
                     Some((t, cos, surface, refl)) => {
-                        (t, Some(surface), self.lidar.reading(t, cos, refl))
+                        let other = self.spot_side(o, angle);
+                        (t, Some(surface), self.lidar.reading(t, cos, refl, other))
                     }
                     None => (0.0, None, self.lidar.miss()),
                 };
@@ -297,6 +309,16 @@ impl Scenario {
         frame.pose_end = self.robot.pose;
     }
 
+    /// What the far side of the beam's spot hits, m, for a unit with mixed pixels.
+    fn spot_side(&mut self, o: Point2, angle: f32) -> Option<f32> {
+        let a = angle + self.lidar.spot_offset()?;
+        let hit = self.world.raycast(o, a, MAX_RANGE_M).map(|(t, idx, cos)| {
+            let prim = &self.world.prims[idx];
+            (t, cos, prim.surface, prim.reflectivity)
+        });
+        self.nearer_person(o, a, hit).map(|h| h.0)
+    }
+
     /// `hit` (distance, cosine of incidence, surface, reflectivity), or a walking person's leg
     /// if one is nearer along the ray.
     fn nearer_person(
@@ -327,6 +349,9 @@ impl Scenario {
         best
     }
 }
+
+/// Salt of the stream that decides whether a scenario's LiDAR is worn ([`ScenarioConfig::worn`]).
+const WEAR_SALT: u64 = 0x3EA2_F00D_71C5_0B9E;
 
 /// Salt of the people's own random stream ([`Scenario::add_people`]).
 const PEOPLE_SALT: u64 = 0x9E0F_1E5B_2A47_C3D8;
@@ -409,6 +434,38 @@ mod test {
         );
         let walked = seen[0].distance(seen[seen.len() - 1]);
         assert!(walked > 0.3, "it moved {walked} m");
+    }
+
+    #[test]
+    fn a_worn_lidar_reads_between_surfaces_and_loses_far_returns() {
+        // (returns, returns off their surface by more than the noise's bound, returns beyond 2 m)
+        let tally = |worn: f64| {
+            let cfg = ScenarioConfig {
+                worn,
+                ..ScenarioConfig::standard()
+            };
+            let (mut off, mut returns, mut far) = (0, 0, 0);
+            for seed in 0..4 {
+                let mut s = Scenario::new(seed, &cfg);
+                assert_eq!(s.lidar.cfg().wear.has_spot(), worn > 0.0);
+                let (mut f, mut odom) = (Frame::default(), Vec::new());
+                for _ in 0..10 {
+                    s.next_frame(&mut f, &mut odom);
+                    for r in f.readings.iter().filter(|r| r.raw.range_mm != 0) {
+                        let (m, t) = (f32::from(r.raw.range_mm) / 1000.0, r.true_range_m);
+                        returns += 1;
+                        off += usize::from((m - t).abs() > 0.08 * t + 0.05);
+                        far += usize::from(t > 2.0);
+                    }
+                }
+            }
+            (returns, off, far)
+        };
+        let (n0, off0, far0) = tally(0.0);
+        let (n1, off1, far1) = tally(1.0);
+        assert_eq!(off0, 0, "a fresh unit reads every return on its surface");
+        assert!(off1 * 400 > n1, "mixed pixels: {off1} of {n1}");
+        assert!(n1 < n0 && far1 < far0, "{n1} < {n0}, {far1} < {far0}");
     }
 
     #[test]

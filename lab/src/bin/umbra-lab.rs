@@ -220,6 +220,8 @@ enum FamilyArg {
     Sim,
     /// The simulator's varied worlds (what Method B now trains on), held-out seeds.
     Varied,
+    /// The varied worlds seen by a worn LiDAR (returns fading with range, mixed pixels).
+    Worn,
     Annex,
     /// sim and annex.
     Both,
@@ -534,6 +536,7 @@ fn run(cli: Cli) -> Result<(), String> {
             let families = match family {
                 FamilyArg::Sim => vec![Family::Sim],
                 FamilyArg::Varied => vec![Family::Varied],
+                FamilyArg::Worn => vec![Family::Worn],
                 FamilyArg::Annex => vec![Family::Annex],
                 FamilyArg::Both => vec![Family::Sim, Family::Annex],
                 FamilyArg::All => vec![Family::Sim, Family::Varied, Family::Annex],

@@ -31,6 +31,9 @@ pub enum Family {
     /// umbra's simulator drawing only varied worlds (`WorldConfig::varied`), held-out seeds:
     /// the kind of world Method B has been trained on since 2026-11-30, not the study's.
     Varied,
+    /// The varied worlds seen by a worn LiDAR (`sim::wear`: returns fading with range, mixed
+    /// pixels at depth edges), held-out seeds: real scanners' effects in our own simulator.
+    Worn,
     /// The annex: never trained or tuned on.
     Annex,
 }
@@ -41,6 +44,7 @@ impl Family {
         match self {
             Family::Sim => "sim (held-out seeds)",
             Family::Varied => "sim, varied worlds (held-out seeds)",
+            Family::Worn => "sim, varied worlds, worn LiDAR (held-out seeds)",
             Family::Annex => "annex (never tuned on)",
         }
     }
@@ -85,8 +89,9 @@ pub struct Outcome {
 /// Generates run `i` of `family`.
 pub fn generate(family: Family, seed: u64, i: usize, seconds: f64) -> GeneratedRun {
     match family {
-        Family::Sim => sim_family::generate(seed, i, seconds, 0.0),
-        Family::Varied => sim_family::generate(seed, i, seconds, 1.0),
+        Family::Sim => sim_family::generate(seed, i, seconds, 0.0, 0.0),
+        Family::Varied => sim_family::generate(seed, i, seconds, 1.0, 0.0),
+        Family::Worn => sim_family::generate(seed, i, seconds, 1.0, 1.0),
         Family::Annex => {
             let lidar = if i % 4 >= 2 {
                 drivers::lidar::LidarModel::Lds02
@@ -194,6 +199,7 @@ pub fn evaluate(cfg: &EvalConfig, mut progress: impl FnMut(&str)) -> Result<Vec<
             let tag = match family {
                 Family::Sim => "sim",
                 Family::Varied => "varied",
+                Family::Worn => "worn",
                 Family::Annex => "annex",
             };
             let dir = cfg.dir.join(format!("{tag}-{i:03}"));

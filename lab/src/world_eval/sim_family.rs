@@ -138,15 +138,17 @@ fn rays_through(frame: &Frame, footprint: &[Point2]) -> usize {
 /// walking (`sim::people`, drawn from their own salted stream, so the room, robot and LiDAR
 /// are the same with or without them), one piece moved in half the runs; a share
 /// `varied` of the worlds drawn varied (`WorldConfig::varied`, then with up to 6 clutter
-/// items as the training data has them).
-pub fn generate(seed: u64, i: usize, seconds: f64, varied: f64) -> GeneratedRun {
+/// items as the training data has them); a share `worn` of the runs seen by a worn LiDAR
+/// (`ScenarioConfig::worn`).
+pub fn generate(seed: u64, i: usize, seconds: f64, varied: f64, worn: f64) -> GeneratedRun {
     let world = WorldConfig {
         kinds: vec![RoomKind::Rect, RoomKind::LShape, RoomKind::TwoRooms],
         varied,
         max_clutter: if varied > 0.0 { 6 } else { 3 },
         ..WorldConfig::default()
     };
-    let cfg = scenario_config(i, &world);
+    let mut cfg = scenario_config(i, &world);
+    cfg.worn = worn;
     let run_seed = scenario_seed(seed, i);
     let mut s = Scenario::new(run_seed, &cfg);
     let start = s.robot_start_pose();

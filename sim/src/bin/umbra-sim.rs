@@ -107,6 +107,10 @@ enum Command {
         /// default from the robot's pose at the middle of the revolution.
         #[arg(long)]
         deskew: bool,
+        /// Share of scenarios whose LiDAR is a worn unit (0–1): returns that fade with range and
+        /// mixed pixels at depth edges (`sim::wear`).
+        #[arg(long, default_value_t = 0.0)]
+        worn: f64,
     },
     /// Labelled frames per second, rasters and labels in memory.
     Speed {
@@ -200,6 +204,7 @@ fn run(command: Command) -> Result<(), String> {
             people,
             seam,
             deskew,
+            worn,
         } => {
             let cfg = DatasetConfig {
                 scenarios,
@@ -224,6 +229,7 @@ fn run(command: Command) -> Result<(), String> {
                     Seam::Quiet => SeamRule::Quiet,
                 },
                 deskew,
+                worn,
                 ..DatasetConfig::default()
             };
             let bar = ProgressBar::new((scenarios * frames) as u64);
