@@ -391,7 +391,8 @@ fn run_loop(
         method_a: cfg.method_a.enabled.then(|| (cfg.method_a(), mount)),
         method_b,
         world: cfg.world.enabled.then(|| cfg.world.tracks(b_runs)),
-        track_log: common.track_log.clone(),
+        track_log: crate::runner::TrackLog::create(common.track_log.as_deref())
+            .map_err(|e| (EXIT_USAGE, e.to_string()))?,
     };
     let scheduling = crate::realtime::apply(cfg.runtime.scheduling, cfg.runtime.fifo_priority);
     log::info!("frame loop: {scheduling}");

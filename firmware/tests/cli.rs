@@ -251,6 +251,12 @@ fn errors_name_what_is_wrong_and_exit_2_or_1() {
     assert_eq!(out.status.code(), Some(1));
     assert!(String::from_utf8_lossy(&out.stderr).contains("/dev/umbra-no-such-port"));
 
+    // An output file that cannot be made is a start-up error, as for --record and --snapshot.
+    let out = umbra(&["run", "--frames", "1", "--track-log", "/nonexistent/t.txt"]);
+    assert_eq!(out.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("--track-log /nonexistent/t.txt"), "{err}");
+
     let out = umbra(&["run", "--frames", "x"]);
     assert_eq!(out.status.code(), Some(2));
     let out = umbra(&["run", "--lidar-model", "ld06", "--frames", "1"]);

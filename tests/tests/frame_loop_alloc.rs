@@ -96,7 +96,7 @@ fn per_frame_from(
         sinks.push(Box::new(VizSink::new(link)));
     }
     let opts = RunOptions {
-        track_log: None,
+        track_log: Default::default(),
         frames: Some(FRAMES),
         seconds: None,
         seconds_clock: SecondsClock::Wall,

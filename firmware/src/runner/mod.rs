@@ -37,6 +37,7 @@ pub use b_worker::B_WORKER_JOB_BYTES;
 pub use history::{METHOD_B_HISTORY, ScanHistory};
 pub use method_b::{MethodBScratch, MethodBSetup, Network, Schedule, Seam, drawing, follow_model};
 pub use summary::Summary;
+pub use track_log::TrackLog;
 
 use crate::deadline::{Budgets, PowerVerdict};
 use crate::link_watch::LinkWatch;
@@ -87,8 +88,9 @@ pub struct RunOptions {
     pub method_b: Option<MethodBSetup>,
     /// The world model's settings; `None`: off (`objects` are the frame's detections).
     pub world: Option<TrackConfig>,
-    /// Write each frame's reportable tracks and their report features here (`--track-log`).
-    pub track_log: Option<std::path::PathBuf>,
+    /// Each frame's reportable tracks and their report features (`--track-log`), opened at
+    /// start-up; the default writes nothing.
+    pub track_log: TrackLog,
 }
 
 /// Method B's stage budget on its own thread, in deadlines (at least).
@@ -103,7 +105,7 @@ pub fn run<S: RevolutionStream>(
     let start = Instant::now();
     let records = opts.sinks.iter().any(|s| s.records_input());
     let mut st = FrameState::new(records);
-    st.track_log = track_log::TrackLog::create(opts.track_log.as_deref())?;
+    st.track_log = std::mem::take(&mut opts.track_log);
     // The LiDAR's pose on the robot, from whichever method has it.
     let mount = match (&opts.method_a, &opts.method_b) {
         (Some((_, m)), _) => *m,

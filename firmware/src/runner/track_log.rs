@@ -15,13 +15,13 @@ const BUFFER_BYTES: usize = 1 << 16;
 
 /// Where the tracks go; `None` inside: no log.
 #[derive(Default)]
-pub(super) struct TrackLog {
+pub struct TrackLog {
     out: Option<BufWriter<File>>,
 }
 
 impl TrackLog {
     /// Opens `path` (none: no log) and writes the header line.
-    pub(super) fn create(path: Option<&Path>) -> io::Result<Self> {
+    pub fn create(path: Option<&Path>) -> io::Result<Self> {
         let Some(path) = path else {
             return Ok(TrackLog::default());
         };
