@@ -3,10 +3,11 @@
 
 The report model (`perception/src/tracks/report_model.rs`) is a logistic model of how likely
 a track that earned its report is a phantom, from the features `umbra --track-log` writes for
-every such track in every frame. Its labels come from the runs' truth, by the rule the
-evaluation counts phantoms with (`umbra-lab eval-world`): a piece of furniture is a phantom
-in a frame when no piece stood within 0.3 m of its centre (the footprint's edge) in that frame.
-Door frames are left out: the map's walls judge them.
+every such track in every frame. Its labels are the evaluation's own: `umbra-lab eval-world
+--track-logs` writes, beside each run's `tracks.txt`, a `labels.txt` saying of every reported
+piece of furniture in every frame whether the scorer counted it a phantom
+(`lab/src/world_eval/score.rs`), so the rule lives in one place. Door frames are left out:
+the map's walls judge them.
 
 Fit on the tuning seeds only, never on the held-out ones (9001-9003) or the annex:
 
@@ -23,66 +24,35 @@ prints the share of phantom and of real track-frames each threshold would hold b
 from __future__ import annotations
 
 import argparse
-import math
 import re
 from pathlib import Path
 
 import numpy as np
 
-PIECE = re.compile(
-    r"furniture (\d+) \(piece (\d+)\): (\w+) (.*?) at \(([-\d.]+), ([-\d.]+)\), "
-    r"frames (\d+)\.\.(\w+), (\d+) returns, footprint (.*)"
-)
-POINT = re.compile(r"\(([-\d.]+), ([-\d.]+)\)")
-# The evaluation's reach: a detection within this of a piece's footprint stands on it, m.
-ON_PIECE_M = 0.3
-# Frames after a piece leaves during which a report of it is not yet a phantom.
-LEAVE_GRACE = 10
-
-
-def edge_distance(poly: list[tuple[float, float]], x: float, y: float) -> float:
-    """Distance from (x, y) to the polygon (0 inside)."""
-    inside, best, n = False, math.inf, len(poly)
-    for i in range(n):
-        (x1, y1), (x2, y2) = poly[i], poly[(i + 1) % n]
-        if (y1 > y) != (y2 > y) and x < (x2 - x1) * (y - y1) / (y2 - y1) + x1:
-            inside = not inside
-        dx, dy = x2 - x1, y2 - y1
-        ll = dx * dx + dy * dy
-        t = max(0.0, min(1.0, ((x - x1) * dx + (y - y1) * dy) / ll)) if ll else 0.0
-        best = min(best, math.hypot(x - x1 - t * dx, y - y1 - t * dy))
-    return 0.0 if inside else best
-
-
-def pieces(truth: Path) -> list[tuple[list[tuple[float, float]], int, float]]:
-    """Each piece's footprint and the frames it stood there."""
-    out = []
-    for line in truth.read_text().splitlines()[1:]:
-        m = PIECE.match(line)
-        if m:
-            fp = [(float(a), float(b)) for a, b in POINT.findall(m.group(10))]
-            end = math.inf if m.group(8) == "end" else int(m.group(8))
-            out.append((fp, int(m.group(7)), end))
-    return out
-
-
 def read_run(run: Path) -> tuple[list[str], np.ndarray, np.ndarray]:
-    """A run's furniture track-frames: feature names, features, labels (1 = phantom)."""
+    """A run's furniture track-frames: feature names, features, labels (1 = phantom).
+
+    The labels are the evaluation's own (`labels.txt`, written by `umbra-lab eval-world
+    --track-logs` beside `tracks.txt`): one per reported piece of furniture and frame. A logged
+    track that was not reported (held back by a report model already on) has none and is left
+    out.
+    """
     lines = (run / "tracks.txt").read_text().splitlines()
     names = lines[0].lstrip("# ").split()[6:]
-    truth = pieces(run / "truth.txt")
+    phantom = {}
+    for line in (run / "labels.txt").read_text().splitlines()[1:]:
+        frame, ident, label = line.split()
+        phantom[(int(frame), int(ident))] = int(label)
     rows, labels = [], []
     for line in lines[1:]:
         c = line.split()
         if len(c) != 6 + len(names) or c[2] == "door_frame":
             continue
-        frame, x, y = int(c[0]), float(c[3]), float(c[4])
-        on = any(
-            a <= frame < b + LEAVE_GRACE and edge_distance(fp, x, y) <= ON_PIECE_M
-            for fp, a, b in truth
-        )
+        label = phantom.get((int(c[0]), int(c[1])))
+        if label is None:
+            continue
         rows.append([float(v) for v in c[6:]])
-        labels.append(0 if on else 1)
+        labels.append(label)
     return names, np.array(rows, dtype=np.float64).reshape(-1, len(names)), np.array(labels)
 
 

@@ -18,7 +18,8 @@
 # seconds from the start after which training is interrupted, so the weights saved at the last
 # epoch still come back inside the call's 600 s), INIT (checkpoints/continue.pt, relative to
 # training/), and the data's mix: VARIED (0), ROUND (0), OFFICE (0), PEOPLE (0), CLUTTER (6),
-# the `umbra-sim dataset` options of the same names (`--round-tables`, `--office-chairs`),
+# WORN (0), the `umbra-sim dataset` options of the same names (`--round-tables`,
+# `--office-chairs`, `--worn`: the share of scenarios seen by a worn LiDAR, `sim::wear`),
 # KINDS (rect,tworooms), FRAMES (4), and how the images are drawn: SEAM (fixed; quiet) and
 # DESKEW (0; 1: swept labels). The set's dataset.json comes back with the weights: export with
 # `training/export.py --seam S --deskew true|false` as it says, so the files declare it.
@@ -40,6 +41,7 @@ ROUND=${ROUND:-0}
 OFFICE=${OFFICE:-0}
 PEOPLE=${PEOPLE:-0}
 CLUTTER=${CLUTTER:-6}
+WORN=${WORN:-0}
 KINDS=${KINDS:-rect,tworooms}
 FRAMES=${FRAMES:-4}
 SEAM=${SEAM:-fixed}
@@ -66,7 +68,7 @@ t0=$(date +%s)
 rm -rf "$DATA"
 .gpu/umbra-sim dataset --out "$DATA" --scenarios "$SCENARIOS" --frames "$FRAMES" \
     --seed "$SEED" --kinds "$KINDS" --clutter "$CLUTTER" --varied "$VARIED" \
-    --round-tables "$ROUND" --office-chairs "$OFFICE" --people "$PEOPLE" "${DRAW[@]}" \
+    --round-tables "$ROUND" --office-chairs "$OFFICE" --people "$PEOPLE" --worn "$WORN" "${DRAW[@]}" \
     --no-method-a --no-recordings --pictures 0 >"$OUT/dataset.log"
 cp "$DATA/dataset.json" "$OUT/dataset.json"
 echo "dataset: $(ls "$DATA/images/train" | wc -l) train images in $(( $(date +%s) - t0 )) s"

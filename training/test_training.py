@@ -218,16 +218,15 @@ def test_report_model_fit() -> None:
     from fit_report_model import fit, prob, raw_weights, read_run, rust
 
     run = Path(tempfile.mkdtemp())
-    (run / "truth.txt").write_text(
-        "run\nfurniture 0 (piece 0): box solid at (1.00, 0.00), frames 0..end, 50 returns, "
-        "footprint (0.8, -0.2) (1.2, -0.2) (1.2, 0.2) (0.8, 0.2)\n")
     names = ["score", "rate"]
     (run / "tracks.txt").write_text(
         "# frame id class x y source score rate\n"
-        "5 1 box 1.100 0.100 B 0.9 1.0\n"      # on the piece
-        "5 2 box 1.450 0.000 B 0.4 0.5\n"      # 0.25 m off its edge: still on it
-        "5 3 chair 2.000 1.000 B 0.3 0.4\n"    # off every piece: a phantom
-        "5 4 door_frame 3.000 0.000 B 0.5 1.0\n")
+        "5 1 box 1.100 0.100 B 0.9 1.0\n"
+        "5 2 box 1.450 0.000 B 0.4 0.5\n"
+        "5 3 chair 2.000 1.000 B 0.3 0.4\n"
+        "5 4 door_frame 3.000 0.000 B 0.5 1.0\n"   # left to the doors
+        "5 5 desk 0.000 3.000 B 0.2 0.1\n")        # logged, not reported: no label
+    (run / "labels.txt").write_text("# frame id phantom\n5 1 0\n5 2 0\n5 3 1\n")
     got_names, x, y = read_run(run)
     assert got_names == names and y.tolist() == [0, 0, 1], (got_names, y)
     assert x.shape == (3, 2)
@@ -246,9 +245,6 @@ def test_report_model_fit() -> None:
 
 if __name__ == "__main__":
     test_report_model_fit()
-    test_conventions_declared()
-
-if __name__ == "__main__":
     test_conventions_declared()
     test_qat_ranges_carried(Path(sys.argv[1]))
     test_qat_emulates_int8(Path(sys.argv[1]))

@@ -152,6 +152,7 @@ mod test {
 
     fn line(i: usize, objects: Vec<Reported>, detections: Vec<Reported>) -> Line {
         Line {
+            frame: None,
             t: i as f64 * 0.2,
             objects,
             detections: Some(detections),

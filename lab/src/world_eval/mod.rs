@@ -69,7 +69,8 @@ pub struct EvalConfig {
     pub dir: PathBuf,
     /// Extra `[world]` lines for the world-on replays (`key = value`), for ablations.
     pub world_set: Vec<String>,
-    /// Have the world-on replays write their track logs (`tracks.txt`, `umbra --track-log`).
+    /// Have the world-on replays write their track logs (`tracks.txt`, `umbra --track-log`)
+    /// and the scorer's phantom labels of what they reported (`labels.txt`).
     pub track_logs: bool,
 }
 
@@ -225,6 +226,9 @@ pub fn evaluate(cfg: &EvalConfig, mut progress: impl FnMut(&str)) -> Result<Vec<
                 .map_err(|e| e.to_string())?;
                 let mut t = Tally::default();
                 score_run(&run.truth, &lines, &mut t);
+                if o.world && cfg.track_logs {
+                    write_labels(&dir.join("labels.txt"), &t.object_labels)?;
+                }
                 o.tally.add(&t);
                 o.runs.push((run.truth.name.clone(), t));
             }
@@ -233,6 +237,16 @@ pub fn evaluate(cfg: &EvalConfig, mut progress: impl FnMut(&str)) -> Result<Vec<
         out.extend(per);
     }
     Ok(out)
+}
+
+/// `labels.txt` beside a run's track log: each reported piece of furniture's frame, id and
+/// whether the scorer counted it a phantom (1) or not (0), for `training/fit_report_model.py`.
+fn write_labels(path: &Path, labels: &[(u64, u64, bool)]) -> Result<(), String> {
+    let mut s = String::from("# frame id phantom\n");
+    for (frame, id, phantom) in labels {
+        let _ = writeln!(s, "{frame} {id} {}", u8::from(*phantom));
+    }
+    std::fs::write(path, s).map_err(|e| format!("{}: {e}", path.display()))
 }
 
 /// The run's truth in words (written beside each run).

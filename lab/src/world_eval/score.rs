@@ -39,6 +39,8 @@ pub struct Reported {
 /// One output line, as far as the scorer reads it.
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct Line {
+    /// The line's `frame` number, when it has one.
+    pub frame: Option<u64>,
     /// Sensor time, s.
     pub t: f64,
     /// `objects`.
@@ -98,6 +100,7 @@ impl Line {
     pub fn parse(s: &str) -> Option<Line> {
         let v: Value = serde_json::from_str(s).ok()?;
         Some(Line {
+            frame: v.get("frame").and_then(Value::as_u64),
             t: v.get("t")?.as_f64()?,
             objects: objects(v.get("objects"))?,
             doors: points(v.get("doors")).unwrap_or_default(),
@@ -214,6 +217,12 @@ pub struct Tally {
     /// The reports on walking people, one line each (frame, id, class, source), for reading.
     #[serde(skip)]
     pub people_reports: Vec<String>,
+    /// Every reported piece of furniture (door frames left to the doors), as `(frame, id,
+    /// phantom)` by this scorer's rule: the labels `training/fit_report_model.py` fits the
+    /// report model on (`labels.txt` beside a run's track log). One run's; [`Tally::add`]
+    /// does not sum them.
+    #[serde(skip)]
+    pub object_labels: Vec<(u64, u64, bool)>,
 }
 
 /// Class names of the tally's per-class arrays.
@@ -282,7 +291,13 @@ pub fn score_run(truth: &RunTruth, lines: &[Line], tally: &mut Tally) {
                     }
                     c => {
                         let mut near = on_furniture(&alive, o.at).peekable();
-                        if main && near.peek().is_none() && unrefuted(truth, fi, o.at, MATCH_M) {
+                        let gone_unseen =
+                            near.peek().is_none() && unrefuted(truth, fi, o.at, MATCH_M);
+                        if let (true, Some(frame)) = (main, line.frame) {
+                            let phantom = near.peek().is_none() && !gone_unseen;
+                            tally.object_labels.push((frame, o.id, phantom));
+                        }
+                        if main && gone_unseen {
                             tally.unrefuted += 1;
                         } else if near.peek().is_none() {
                             phantoms[o.source] += 1;
@@ -656,6 +671,7 @@ mod test {
         let t = truth();
         let lines: Vec<Line> = (0..4)
             .map(|k| Line {
+                frame: None,
                 t: 0.2 * f64::from(k),
                 objects: vec![
                     obj(7, ObjectClass::Chair, 1.0, 0.05),
@@ -689,6 +705,7 @@ mod test {
                 let lag = if k == 0 { 0.0 } else { 2f32.to_radians() };
                 let theta = wrap_angle(3.0 + 0.1 * k as f32 - lag);
                 Line {
+                    frame: None,
                     t: 0.2 * f64::from(k),
                     pose: Some(Pose2::new(if k == 3 { 0.3 } else { 0.0 }, 0.0, theta)),
                     ..Line::default()
@@ -728,6 +745,7 @@ mod test {
                     objects[1].id = 1;
                 }
                 Line {
+                    frame: None,
                     t: 0.2 * f64::from(k),
                     objects,
                     ..Line::default()
@@ -752,6 +770,7 @@ mod test {
         t.furniture[1].to_frame = 1;
         let lines: Vec<Line> = (0..4)
             .map(|k| Line {
+                frame: None,
                 t: 0.2 * f64::from(k),
                 objects: vec![
                     Reported {
@@ -792,8 +811,9 @@ mod test {
             seen_empty: None,
         });
         t.furniture[1].to_frame = 1;
-        let lines: Vec<Line> = (0..4)
+        let lines: Vec<Line> = (0..4u32)
             .map(|k| Line {
+                frame: Some(u64::from(k) + 10),
                 t: 0.2 * f64::from(k),
                 objects: vec![obj(5, ObjectClass::Box, -1.0, 0.0)],
                 ..Line::default()
@@ -815,6 +835,9 @@ mod test {
         score_run(&t, &lines, &mut s);
         assert_eq!((s.phantoms, s.unrefuted), ([0, 0, 2], 1));
         assert_eq!((s.map_reported, s.map_unrefuted), ([0, 1, 0], 0));
+        // The report model's labels say the same, frame by frame, by the line's frame number.
+        let labels = [(10, 5, false), (11, 5, false), (12, 5, true), (13, 5, true)];
+        assert_eq!(s.object_labels, labels);
     }
 
     #[test]
@@ -826,6 +849,7 @@ mod test {
             ..obj(u64::MAX, class, x, y)
         };
         let line = Line {
+            frame: None,
             detections: Some(vec![
                 // Method B: a chair on the chair, a box on the chair (wrong class), a box on
                 // nothing; both methods: a door frame on the door; a score that is no number.
@@ -858,6 +882,7 @@ mod test {
         t.walls
             .push((Point2::new(-5.0, 3.0), Point2::new(5.0, 3.0)));
         let line = Line {
+            frame: None,
             t: 0.0,
             objects: vec![
                 obj(1, ObjectClass::Box, 3.2, -2.0),      // on the pillar
@@ -875,6 +900,7 @@ mod test {
         assert_eq!(s.phantoms_where, [1, 1, 1, 1, 1]);
         assert_eq!(s.phantoms_by_class, [1, 2, 1, 1]);
         let far_frame = Line {
+            frame: None,
             t: 0.2,
             objects: vec![obj(3, ObjectClass::DoorFrame, 0.0, 2.8)],
             ..Line::default()
