@@ -42,6 +42,8 @@ pub struct SceneConfig {
     pub every: usize,
     /// Pose source.
     pub pose: PoseSource,
+    /// Share of scenes seen by a worn LiDAR (`ScenarioConfig::worn`; 0: none).
+    pub worn: f64,
 }
 
 impl Default for SceneConfig {
@@ -53,6 +55,7 @@ impl Default for SceneConfig {
             first: 25,
             every: 15,
             pose: PoseSource::Odometry,
+            worn: 0.0,
         }
     }
 }
@@ -194,7 +197,8 @@ pub fn run_scene(
     classifier: &impl Classifier,
     mut view: impl FnMut(&SceneView<'_>),
 ) {
-    let sc = scenario_config(i, &cfg.world);
+    let mut sc = scenario_config(i, &cfg.world);
+    sc.worn = cfg.worn;
     let mut scenario = Scenario::new(scenario_seed(cfg.seed, i), &sc);
     let start = scenario.robot_start_pose();
     let world_to_map = start.inverse();

@@ -88,6 +88,9 @@ enum Command {
         /// --round-tables`; 0: none).
         #[arg(long, default_value_t = 0.0)]
         round_tables: f64,
+        /// Share of scenes seen by a worn LiDAR (`umbra-sim dataset --worn`; 0: none).
+        #[arg(long, default_value_t = 0.0)]
+        worn: f64,
     },
     /// Writes the detections' score calibration (`models/src/calibration_counts.rs`) from
     /// `eval-world --json` files: each file's families' detection counts by source, class and
@@ -292,10 +295,12 @@ fn run(cli: Cli) -> Result<(), String> {
             varied,
             office_chairs,
             round_tables,
+            worn,
         } => {
             let mut cfg = scene_cfg(seed, pose, Worlds { clutter, varied });
             cfg.world.office_chairs = office_chairs;
             cfg.world.round_tables = round_tables;
+            cfg.worn = worn;
             let mut method = Box::new(MethodA::new());
             let mut text = csv_header();
             text.push('\n');
