@@ -86,7 +86,8 @@ def sets(a) -> dict[str, list[str]]:
     common = ["--frames", str(a.frames)]
     return {
         "train": ["--scenarios", str(a.scenarios), *common, "--seed", str(a.seed), "--kinds",
-                  a.kinds, "--clutter", str(a.clutter), *drawing(a)],
+                  a.kinds, "--clutter", str(a.clutter), *drawing(a),
+                  *(["--worn", str(a.worn)] if a.worn else [])],
         "ood": ["--scenarios", str(a.ood_scenarios), *common, "--seed", str(a.seed + 1),
                 "--kinds", a.ood_kinds, "--clutter", str(a.ood_clutter), "--test-only",
                 *drawing(a)],
@@ -270,6 +271,9 @@ def main() -> None:
     ap.add_argument("--deskew", action="store_true",
                     help="every set's labels drawn where the sweep read them (`--deskew`); "
                     "declared in the exported files like --seam")
+    ap.add_argument("--worn", type=float, default=0.0,
+                    help="share of the training set's scenarios seen by a worn LiDAR "
+                    "(`umbra-sim dataset --worn`); the test sets stay fresh, so figures compare")
     ap.add_argument("--epochs", type=int, default=14)
     ap.add_argument("--batch", type=int, default=32)
     ap.add_argument("--mirror", type=float, default=0.5)
