@@ -13,6 +13,7 @@
 //! | [`lds01`]     | LDS-01 reading model and the packet byte source                       |
 //! | [`people`]    | people walking through a scenario: paths, stance-and-swing gait, giving way |
 //! | [`scenario`]  | world + robot + sensors stepped one revolution (frame) at a time      |
+//! | [`split`]     | which split a dataset's scenario lands in; each scenario's seed      |
 //! | [`labels`]    | Method B boxes from footprints, per-reading labels                    |
 //! | `dataset`     | dataset writers: YOLO layout, Method A labels, replay recordings (feature `tools`) |
 //! | [`noise`]     | the bounded, unit-σ noise every sensor model draws from               |
@@ -37,6 +38,7 @@ pub mod picture;
 pub mod pty;
 pub mod robot;
 pub mod scenario;
+pub mod split;
 pub mod wear;
 pub mod wire;
 pub mod world;

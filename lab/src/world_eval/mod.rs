@@ -1,6 +1,7 @@
 //! `umbra-lab eval-world`: the world as `umbra` reports it, scored against the truth of
-//! runs it has never seen, in two scene families: umbra's simulator on held-out seeds, and
-//! the annex ([`crate::annex`]), written apart and never trained or tuned on.
+//! runs it has never seen, in its scene families: umbra's simulator on held-out seeds (its
+//! own rooms, its varied worlds, those seen by a worn LiDAR), and the annex
+//! ([`crate::annex`]), written apart and never trained or tuned on.
 //!
 //! Each run is written as a user would hand it over (LiDAR bytes, wheel ticks) and replayed
 //! through the `umbra` binary itself (`umbra replay CAPTURE --odom TICKS --jsonl -`), with the
@@ -8,6 +9,7 @@
 
 mod assignment;
 pub mod fates;
+mod line;
 pub mod picture;
 mod places;
 pub mod reliability;
