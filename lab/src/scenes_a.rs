@@ -197,8 +197,7 @@ pub fn run_scene(
     classifier: &impl Classifier,
     mut view: impl FnMut(&SceneView<'_>),
 ) {
-    let mut sc = scenario_config(i, &cfg.world);
-    sc.worn = cfg.worn;
+    let sc = scenario_config(i, &cfg.world, cfg.worn);
     let mut scenario = Scenario::new(scenario_seed(cfg.seed, i), &sc);
     let start = scenario.robot_start_pose();
     let world_to_map = start.inverse();

@@ -98,8 +98,9 @@ impl Default for DatasetConfig {
 
 pub use crate::split::{Split, scenario_seed, splits};
 
-/// The scenario settings of index `i`.
-pub fn scenario_config(i: usize, world: &WorldConfig) -> ScenarioConfig {
+/// The scenario settings of index `i`: `world`'s rooms, even indices turning in place and odd
+/// ones touring, a share `worn` of the units worn (`ScenarioConfig::worn`; 0 = every unit fresh).
+pub fn scenario_config(i: usize, world: &WorldConfig, worn: f64) -> ScenarioConfig {
     let motion = if i.is_multiple_of(2) {
         RobotConfig::default().motion
     } else {
@@ -111,6 +112,7 @@ pub fn scenario_config(i: usize, world: &WorldConfig) -> ScenarioConfig {
             motion,
             ..RobotConfig::default()
         },
+        worn,
         ..ScenarioConfig::standard()
     }
 }
@@ -135,8 +137,7 @@ pub fn simulate(
     mut on_frame: impl FnMut(&Scenario, &Frame, &[OdomSample]),
     mut on_sample: impl FnMut(&Scenario, Sample<'_>),
 ) -> Scenario {
-    let mut sc = scenario_config(i, &cfg.world);
-    sc.worn = cfg.worn;
+    let sc = scenario_config(i, &cfg.world, cfg.worn);
     let mut scenario = Scenario::new(scenario_seed(cfg.seed, i), &sc);
     if cfg.people > 0 {
         scenario.add_people(scenario_seed(cfg.seed, i), cfg.people);

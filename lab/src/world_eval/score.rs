@@ -195,13 +195,14 @@ pub fn score_run(truth: &RunTruth, lines: &[Line], tally: &mut Tally) {
                     }
                     c => {
                         let mut near = on_furniture(&alive, o.at).peekable();
+                        // Only reported objects may be excused; detections skip the test.
                         let gone_unseen =
-                            near.peek().is_none() && unrefuted(truth, fi, o.at, MATCH_M);
+                            main && near.peek().is_none() && unrefuted(truth, fi, o.at, MATCH_M);
                         if let (true, Some(frame)) = (main, line.frame) {
                             let phantom = near.peek().is_none() && !gone_unseen;
                             tally.object_labels.push((frame, o.id, phantom));
                         }
-                        if main && gone_unseen {
+                        if gone_unseen {
                             tally.unrefuted += 1;
                         } else if near.peek().is_none() {
                             phantoms[o.source] += 1;

@@ -147,8 +147,7 @@ pub fn generate(seed: u64, i: usize, seconds: f64, varied: f64, worn: f64) -> Ge
         max_clutter: if varied > 0.0 { 6 } else { 3 },
         ..WorldConfig::default()
     };
-    let mut cfg = scenario_config(i, &world);
-    cfg.worn = worn;
+    let cfg = scenario_config(i, &world, worn);
     let run_seed = scenario_seed(seed, i);
     let mut s = Scenario::new(run_seed, &cfg);
     let start = s.robot_start_pose();
@@ -337,7 +336,7 @@ mod test {
         let mut carried = 0;
         for i in 0..60 {
             let run_seed = scenario_seed(4242, i);
-            let s = Scenario::new(run_seed, &scenario_config(i, &world));
+            let s = Scenario::new(run_seed, &scenario_config(i, &world, 0.0));
             let start = s.robot_start_pose();
             let robot = Point2::new(start.x, start.y);
             if let Some(q) = plan_move(&s.world, run_seed, 150, robot).and_then(|m| m.to) {
