@@ -298,6 +298,19 @@ pub fn describe(t: &crate::run_truth::RunTruth) -> String {
     s
 }
 
+/// Counts by `score::PHANTOM_PLACES`, named; per frame when `frames` is given.
+fn places_of(counts: &[u32; 5], frames: Option<f64>) -> String {
+    let named: Vec<String> = score::PHANTOM_PLACES
+        .iter()
+        .zip(counts)
+        .map(|(name, &n)| match frames {
+            Some(f) => format!("{name} {:.3}", f64::from(n) / f),
+            None => format!("{name} {n}"),
+        })
+        .collect();
+    named.join(", ")
+}
+
 fn pct(x: f64) -> String {
     if x.is_nan() {
         "  –  ".into()
@@ -385,12 +398,11 @@ pub fn report(outcomes: &[Outcome]) -> String {
             f64::from(t.phantoms_by_class[2]) / f,
             f64::from(t.phantoms_by_class[3]) / f
         );
-        let places: Vec<String> = score::PHANTOM_PLACES
-            .iter()
-            .zip(&t.phantoms_where)
-            .map(|(name, &n)| format!("{name} {:.3}", f64::from(n) / f))
-            .collect();
-        let _ = writeln!(s, "    where they lie: {}", places.join(", "));
+        let _ = writeln!(
+            s,
+            "    where they lie: {}",
+            places_of(&t.phantoms_where, Some(f))
+        );
         if t.det_frames > 0 {
             let _ = writeln!(
                 s,
@@ -438,6 +450,20 @@ pub fn report(outcomes: &[Outcome]) -> String {
                 String::new()
             }
         );
+        if t.people_found[0] > 0 || t.people_phantoms > 0 {
+            let r = &t.people_in_view_by_range;
+            let _ = writeln!(
+                s,
+                "    in view by range: under 1.5 m {}/{}, 1.5–2.5 m {}/{}, farther {}/{}; made up where: {}",
+                r[0][1],
+                r[0][0],
+                r[1][1],
+                r[1][0],
+                r[2][1],
+                r[2][0],
+                places_of(&t.people_phantoms_where, None)
+            );
+        }
         if t.pose_frames > 0 {
             let e = &t.final_position_err_m;
             let _ = writeln!(

@@ -21,6 +21,9 @@ pub const MATCH_M: f32 = 0.3;
 pub const DOOR_MATCH_M: f32 = 0.5;
 /// A reported object is on a walking person when within this distance of the legs' midpoint.
 pub const PERSON_M: f32 = 0.4;
+
+/// Where the bands of `Tally::people_in_view_by_range` part, m from the robot.
+pub const PEOPLE_RANGES_M: [f32; 2] = [1.5, 2.5];
 /// Counts, summed over runs; the rates are derived when reporting.
 #[derive(Debug, Clone, Default, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Tally {
@@ -96,6 +99,14 @@ pub struct Tally {
     /// `people` entries with no walking person within reach.
     #[serde(default)]
     pub people_phantoms: u32,
+    /// The people in view by their distance from the robot (`PEOPLE_RANGES_M`: under 1.5 m,
+    /// 1.5–2.5 m, farther): frames × people, and how many a `people` entry was within reach
+    /// of.
+    #[serde(default)]
+    pub people_in_view_by_range: [[u32; 2]; 3],
+    /// `people_phantoms` by where they lie (`PHANTOM_PLACES`).
+    #[serde(default)]
+    pub people_phantoms_where: [u32; 5],
     /// Frames whose `pose` was scored against the robot's true pose, the sum of their
     /// absolute heading errors (degrees), and the largest.
     #[serde(default)]
@@ -260,10 +271,22 @@ pub fn score_run(truth: &RunTruth, lines: &[Line], tally: &mut Tally) {
             tally.people_in_view_found[0] += people.iter().filter(in_view).count() as u32;
             tally.people_in_view_found[1] +=
                 people.iter().filter(in_view).filter(hit).count() as u32;
-            tally.people_phantoms += found
+            if let Some(r) = truth.frames[fi].robot {
+                let robot = Point2::new(r.x, r.y);
+                for p in people.iter().filter(in_view) {
+                    let d = p.at.distance(robot);
+                    let band = PEOPLE_RANGES_M.iter().take_while(|&&m| d >= m).count();
+                    tally.people_in_view_by_range[band][0] += 1;
+                    tally.people_in_view_by_range[band][1] += u32::from(hit(&p));
+                }
+            }
+            for q in found
                 .iter()
                 .filter(|q| people.iter().all(|p| q.distance(p.at) > PERSON_M))
-                .count() as u32;
+            {
+                tally.people_phantoms += 1;
+                tally.people_phantoms_where[phantom_place(truth, &alive, *q)] += 1;
+            }
         }
         // Identity: furniture alive and already visible vs reported furniture-class objects.
         let gt: Vec<usize> = (0..n_f)
@@ -479,8 +502,17 @@ impl Tally {
             people_found,
             people_in_view_found,
             phantoms_by_class,
-            phantoms_where
+            phantoms_where,
+            people_phantoms_where
         );
+        for (a, b) in self
+            .people_in_view_by_range
+            .iter_mut()
+            .zip(&o.people_in_view_by_range)
+        {
+            a[0] += b[0];
+            a[1] += b[1];
+        }
         self.pose_frames += o.pose_frames;
         self.heading_err_sum_deg += o.heading_err_sum_deg;
         self.heading_err_max_deg = self.heading_err_max_deg.max(o.heading_err_max_deg);
