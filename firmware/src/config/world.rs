@@ -17,8 +17,8 @@ pub struct WorldSettings {
     pub people: bool,
     /// Look for people's legs in every revolution (`perception::legs`): a walk they make is a
     /// person in `people` even when neither method took the legs for furniture. Off by
-    /// default: on held-out runs it finds 13 % of the people in view and makes up nearly as
-    /// many (docs/world.md).
+    /// default: on held-out runs it finds 12 % of the people in view and makes up more than
+    /// it finds (docs/world.md, 43rd session).
     pub legs: bool,
     /// Furniture whose detections were, on the whole, of the kinds that are right less often
     /// than this is not reported: each detection's probability is how often detections of its
