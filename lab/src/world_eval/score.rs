@@ -668,6 +668,51 @@ mod test {
     }
 
     #[test]
+    fn people_in_view_are_split_by_range_and_made_up_ones_by_place() {
+        let mut t = truth();
+        // Each frame: one person 1 m from the robot, one 3 m off, one with too few returns
+        // to be in view; the list finds the near one and makes one up in the open.
+        for f in &mut t.frames {
+            f.robot = Some(Pose2::new(0.0, -1.0, 0.0));
+            f.people = vec![
+                Person {
+                    id: 0,
+                    at: Point2::new(0.0, 0.0),
+                    returns: 6,
+                },
+                Person {
+                    id: 1,
+                    at: Point2::new(3.0, -1.0),
+                    returns: 4,
+                },
+                Person {
+                    id: 2,
+                    at: Point2::new(-2.0, -1.0),
+                    returns: 1,
+                },
+            ];
+        }
+        let lines: Vec<Line> = (0..4)
+            .map(|k| Line {
+                t: 0.2 * f64::from(k),
+                people: Some(vec![Point2::new(0.1, 0.1), Point2::new(0.0, -3.0)]),
+                ..Line::default()
+            })
+            .collect();
+        let mut s = Tally::default();
+        score_run(&t, &lines, &mut s);
+        assert_eq!(s.people_in_view_found, [8, 4]);
+        assert_eq!(s.people_in_view_by_range, [[4, 4], [0, 0], [4, 0]]);
+        assert_eq!(s.people_phantoms, 4);
+        assert_eq!(s.people_phantoms_where, [0, 0, 0, 0, 4], "in the open");
+        let mut sum = Tally::default();
+        sum.add(&s);
+        sum.add(&s);
+        assert_eq!(sum.people_in_view_by_range, [[8, 8], [0, 0], [8, 0]]);
+        assert_eq!(sum.people_phantoms_where[4], 8);
+    }
+
+    #[test]
     fn ids_that_trade_places_switch_and_lower_idf1() {
         let t = truth();
         // Ids are list positions, and the list order flips after two frames.
