@@ -8,6 +8,7 @@
 //! world model on or off; the output lines are scored by [`score`].
 
 mod assignment;
+mod describe;
 pub mod fates;
 mod line;
 pub mod picture;
@@ -22,6 +23,7 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 
 use crate::annex::{self, GeneratedRun};
+pub use describe::describe;
 use reliability::{RELIABILITY_LEN, SCORE_BINS};
 use score::{CLASSES, Line, Tally, ratio, score_run};
 
@@ -249,53 +251,6 @@ fn write_labels(path: &Path, labels: &[(u64, u64, bool)]) -> Result<(), String> 
         let _ = writeln!(s, "{frame} {id} {}", u8::from(*phantom));
     }
     std::fs::write(path, s).map_err(|e| format!("{}: {e}", path.display()))
-}
-
-/// The run's truth in words (written beside each run).
-pub fn describe(t: &crate::run_truth::RunTruth) -> String {
-    let mut s = format!("{}\n", t.name);
-    for (k, f) in t.furniture.iter().enumerate() {
-        let c = f.centre();
-        let _ = write!(
-            s,
-            "furniture {k} (piece {}): {} {} at ({:.2}, {:.2}), frames {}..{}, {} returns, footprint",
-            f.piece,
-            f.class.as_str(),
-            f.what,
-            c.x,
-            c.y,
-            f.from_frame,
-            if f.to_frame == usize::MAX {
-                "end".to_string()
-            } else {
-                f.to_frame.to_string()
-            },
-            f.returns
-        );
-        // The footprint, for reading a run's phantoms against the shape they stand beside.
-        for q in &f.footprint {
-            let _ = write!(s, " ({:.2}, {:.2})", q.x, q.y);
-        }
-        s.push('\n');
-    }
-    for d in &t.doors {
-        let _ = writeln!(
-            s,
-            "door at ({:.2}, {:.2}), {:.2} m, {} returns",
-            d.centre.x, d.centre.y, d.width, d.returns
-        );
-    }
-    for (c, w) in &t.clutter {
-        let _ = writeln!(s, "clutter: {w} at ({:.2}, {:.2})", c.x, c.y);
-    }
-    for m in &t.moves {
-        let _ = writeln!(
-            s,
-            "move: furniture {} gone from frame {}, seen empty at {:?}",
-            m.before, m.frame, m.seen_empty
-        );
-    }
-    s
 }
 
 /// Counts by `score::PHANTOM_PLACES`, named; per frame when `frames` is given.

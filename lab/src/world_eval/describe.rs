@@ -1,0 +1,92 @@
+//! A run's truth in words (`truth.txt` beside its output lines): furniture with footprints,
+//! doors, clutter, wall faces and moves, for reading a run's phantoms by hand.
+
+use std::fmt::Write as _;
+
+/// The run's truth in words (written beside each run).
+pub fn describe(t: &crate::run_truth::RunTruth) -> String {
+    let mut s = format!("{}\n", t.name);
+    for (k, f) in t.furniture.iter().enumerate() {
+        let c = f.centre();
+        let _ = write!(
+            s,
+            "furniture {k} (piece {}): {} {} at ({:.2}, {:.2}), frames {}..{}, {} returns, footprint",
+            f.piece,
+            f.class.as_str(),
+            f.what,
+            c.x,
+            c.y,
+            f.from_frame,
+            if f.to_frame == usize::MAX {
+                "end".to_string()
+            } else {
+                f.to_frame.to_string()
+            },
+            f.returns
+        );
+        // The footprint, for reading a run's phantoms against the shape they stand beside.
+        for q in &f.footprint {
+            let _ = write!(s, " ({:.2}, {:.2})", q.x, q.y);
+        }
+        s.push('\n');
+    }
+    for d in &t.doors {
+        let _ = writeln!(
+            s,
+            "door at ({:.2}, {:.2}), {:.2} m, {} returns",
+            d.centre.x, d.centre.y, d.width, d.returns
+        );
+    }
+    for (c, w) in &t.clutter {
+        let _ = writeln!(s, "clutter: {w} at ({:.2}, {:.2})", c.x, c.y);
+    }
+    for (a, b) in &t.walls {
+        let _ = writeln!(
+            s,
+            "wall face ({:.2}, {:.2}) to ({:.2}, {:.2})",
+            a.x, a.y, b.x, b.y
+        );
+    }
+    for m in &t.moves {
+        let _ = writeln!(
+            s,
+            "move: furniture {} gone from frame {}, seen empty at {:?}",
+            m.before, m.frame, m.seen_empty
+        );
+    }
+    s
+}
+
+#[cfg(test)]
+mod test {
+    use super::*;
+    use crate::run_truth::{Door, RunTruth};
+    use perception::geometry::Point2;
+
+    #[test]
+    fn the_truth_in_words_names_doors_clutter_and_wall_faces() {
+        let t = RunTruth {
+            name: "sim 0: rect".into(),
+            furniture: vec![],
+            doors: vec![Door {
+                centre: Point2::new(1.0, 2.0),
+                width: 0.9,
+                returns: 40,
+            }],
+            clutter: vec![(Point2::new(-1.0, 0.5), "bin".into())],
+            frames: vec![],
+            moves: vec![],
+            walls: vec![(Point2::new(0.0, 0.0), Point2::new(4.0, 0.0))],
+        };
+        let s = describe(&t);
+        assert_eq!(
+            s.lines().collect::<Vec<_>>(),
+            [
+                "sim 0: rect",
+                "door at (1.00, 2.00), 0.90 m, 40 returns",
+                "clutter: bin at (-1.00, 0.50)",
+                "wall face (0.00, 0.00) to (4.00, 0.00)",
+            ]
+        );
+    }
+}
