@@ -21,9 +21,9 @@ pub const MATCH_M: f32 = 0.3;
 pub const DOOR_MATCH_M: f32 = 0.5;
 /// A reported object is on a walking person when within this distance of the legs' midpoint.
 pub const PERSON_M: f32 = 0.4;
-
 /// Where the bands of `Tally::people_in_view_by_range` part, m from the robot.
 pub const PEOPLE_RANGES_M: [f32; 2] = [1.5, 2.5];
+
 /// Counts, summed over runs; the rates are derived when reporting.
 #[derive(Debug, Clone, Default, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Tally {
@@ -265,19 +265,21 @@ pub fn score_run(truth: &RunTruth, lines: &[Line], tally: &mut Tally) {
         }
         if let Some(found) = &line.people {
             let hit = |p: &&Person| found.iter().any(|q| q.distance(p.at) <= PERSON_M);
-            let in_view = |p: &&Person| p.returns >= PERSON_VISIBLE_RETURNS;
             tally.people_found[0] += people.len() as u32;
             tally.people_found[1] += people.iter().filter(hit).count() as u32;
-            tally.people_in_view_found[0] += people.iter().filter(in_view).count() as u32;
-            tally.people_in_view_found[1] +=
-                people.iter().filter(in_view).filter(hit).count() as u32;
-            if let Some(r) = truth.frames[fi].robot {
-                let robot = Point2::new(r.x, r.y);
-                for p in people.iter().filter(in_view) {
+            let robot = truth.frames[fi].robot.map(|r| Point2::new(r.x, r.y));
+            for p in people
+                .iter()
+                .filter(|p| p.returns >= PERSON_VISIBLE_RETURNS)
+            {
+                let got = u32::from(hit(&p));
+                tally.people_in_view_found[0] += 1;
+                tally.people_in_view_found[1] += got;
+                if let Some(robot) = robot {
                     let d = p.at.distance(robot);
                     let band = PEOPLE_RANGES_M.iter().take_while(|&&m| d >= m).count();
                     tally.people_in_view_by_range[band][0] += 1;
-                    tally.people_in_view_by_range[band][1] += u32::from(hit(&p));
+                    tally.people_in_view_by_range[band][1] += got;
                 }
             }
             for q in found
