@@ -1,5 +1,6 @@
 //! A run's truth in words (`truth.txt` beside its output lines): furniture with footprints,
-//! doors, clutter, wall faces and moves, for reading a run's phantoms by hand.
+//! doors, clutter, wall faces and moves, for reading a run's phantoms by hand; and its
+//! walking people frame by frame (`people.txt`), for reading what a report near one came from.
 
 use std::fmt::Write as _;
 
@@ -57,10 +58,26 @@ pub fn describe(t: &crate::run_truth::RunTruth) -> String {
     s
 }
 
+/// The run's walking people frame by frame (written beside each run that has any): one line
+/// per person and frame, `frame F t T: person ID at (X, Y), R returns`.
+pub fn describe_people(t: &crate::run_truth::RunTruth) -> String {
+    let mut s = String::new();
+    for (fi, f) in t.frames.iter().enumerate() {
+        for p in &f.people {
+            let _ = writeln!(
+                s,
+                "frame {fi} t {:.3}: person {} at ({:.2}, {:.2}), {} returns",
+                f.t, p.id, p.at.x, p.at.y, p.returns
+            );
+        }
+    }
+    s
+}
+
 #[cfg(test)]
 mod test {
     use super::*;
-    use crate::run_truth::{Door, RunTruth};
+    use crate::run_truth::{Door, FrameTruth, Person, RunTruth};
     use perception::geometry::Point2;
 
     #[test]
@@ -86,6 +103,39 @@ mod test {
                 "door at (1.00, 2.00), 0.90 m, 40 returns",
                 "clutter: bin at (-1.00, 0.50)",
                 "wall face (0.00, 0.00) to (4.00, 0.00)",
+            ]
+        );
+    }
+
+    #[test]
+    fn the_walking_people_are_listed_frame_by_frame() {
+        let person = |id, x| Person {
+            id,
+            at: Point2::new(x, 1.0),
+            returns: 4,
+        };
+        let frame = |t, people| FrameTruth {
+            t,
+            people,
+            robot: None,
+        };
+        let t = RunTruth {
+            name: "sim 0: rect".into(),
+            furniture: vec![],
+            doors: vec![],
+            clutter: vec![],
+            frames: vec![
+                frame(0.0, vec![]),
+                frame(0.2, vec![person(0, 0.5), person(1, -2.0)]),
+            ],
+            moves: vec![],
+            walls: vec![],
+        };
+        assert_eq!(
+            describe_people(&t).lines().collect::<Vec<_>>(),
+            [
+                "frame 1 t 0.200: person 0 at (0.50, 1.00), 4 returns",
+                "frame 1 t 0.200: person 1 at (-2.00, 1.00), 4 returns",
             ]
         );
     }

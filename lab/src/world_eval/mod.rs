@@ -23,7 +23,7 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 
 use crate::annex::{self, GeneratedRun};
-pub use describe::describe;
+pub use describe::{describe, describe_people};
 use reliability::{RELIABILITY_LEN, SCORE_BINS};
 use score::{CLASSES, Line, Tally, ratio, score_run};
 
@@ -211,6 +211,10 @@ pub fn evaluate(cfg: &EvalConfig, mut progress: impl FnMut(&str)) -> Result<Vec<
             std::fs::create_dir_all(&dir).map_err(|e| e.to_string())?;
             std::fs::write(dir.join("truth.txt"), describe(&run.truth))
                 .map_err(|e| e.to_string())?;
+            let people = describe_people(&run.truth);
+            if !people.is_empty() {
+                std::fs::write(dir.join("people.txt"), people).map_err(|e| e.to_string())?;
+            }
             for o in &mut per {
                 let lines = replay(
                     &cfg.umbra,
