@@ -20,7 +20,8 @@
 //! point's bearing, and the one beyond each, all returned from farther than the point by a
 //! margin. Any surface through the point, however grazing, would have stopped one of the two
 //! rays that bracket it short of that, so a wall seen at a glancing angle keeps its points; a
-//! bin with no return says nothing (dark surfaces drop out).
+//! bin with no return says nothing (dark surfaces drop out) unless
+//! [`CloudConfig::clear_beyond_rays`] is set below 4.
 
 use heapless::Deque;
 
@@ -42,6 +43,15 @@ pub struct CloudConfig {
     /// A point is forgotten when the rays around its bearing all return from farther than
     /// it by this plus 3 % of its range, metres ([`GlobalCloud::clear_seen_through`]); 0: never.
     pub clear_margin_m: f32,
+    /// Of the four rays around a point's bearing, how many must have returned from beyond it
+    /// for it to be forgotten ([`GlobalCloud::clear_seen_through`]); the others may have
+    /// returned nothing. 4: a ray that returned nothing says nothing. Below 4, a walking
+    /// person's legs seen in front of a doorway or of open space past the range are
+    /// forgotten once the person has gone (otherwise they are only aged, and leave a trail
+    /// Method A clusters into furniture), but so are the returns a legged chair far off
+    /// gathers over many revolutions where its legs drop out: 4 by default (`docs/world.md`,
+    /// 44th session, measured 1–3).
+    pub clear_beyond_rays: u8,
 }
 
 impl Default for CloudConfig {
@@ -51,6 +61,7 @@ impl Default for CloudConfig {
             range_min_m: 0.12,
             range_max_m: 3.5,
             clear_margin_m: 0.15,
+            clear_beyond_rays: 4,
         }
     }
 }
@@ -196,7 +207,13 @@ impl GlobalCloud {
     /// by the LiDAR's motion between the two instants, taken as linear in time within one
     /// revolution (as `add_scan` de-skews), so each point costs two `atan2`, one `sincos` of
     /// that small turn and one square root, not a pose composition.
-    pub fn clear_seen_through(&mut self, scan: &Scan<'_>, margin_m: f32) -> usize {
+    ///
+    /// At least `beyond_rays` of the four (clamped to 1–4) must have returned from beyond the
+    /// point, and the others nothing: open space past the range (a doorway, a large room)
+    /// returns nothing, and a surface at the point, however dark, would have stopped the rays
+    /// that returned from beyond.
+    pub fn clear_seen_through(&mut self, scan: &Scan<'_>, margin_m: f32, beyond_rays: u8) -> usize {
+        let beyond_rays = usize::from(beyond_rays.clamp(1, 4));
         let n = scan.ranges.len();
         if n < 4 || margin_m.is_nan() || margin_m <= 0.0 {
             return 0;
@@ -245,10 +262,14 @@ impl GlobalCloud {
             }
             let beyond = rho + margin_m + CLEAR_MARGIN_FRACTION * rho;
             let first_bin = libm::floorf(bins) as usize + n - 1;
-            (first_bin..first_bin + 4).all(|d| {
+            let mut past = 0;
+            let all = (first_bin..first_bin + 4).all(|d| {
                 let r = scan.ranges[d % n];
-                r.is_finite() && r > beyond
-            })
+                let beyond = r.is_finite() && r > beyond;
+                past += usize::from(beyond);
+                beyond || r == 0.0
+            });
+            all && past >= beyond_rays
         };
         let len = self.pts.len();
         let mut cleared = 0;
@@ -271,7 +292,7 @@ impl GlobalCloud {
     /// the cloud by one revolution and adds `scan`'s returns within the configured range
     /// window; returns how many were added. Non-finite ranges are refused and counted.
     pub fn add_scan(&mut self, scan: &Scan<'_>, cfg: &CloudConfig) -> usize {
-        self.clear_seen_through(scan, cfg.clear_margin_m);
+        self.clear_seen_through(scan, cfg.clear_margin_m, cfg.clear_beyond_rays);
         self.age(cfg.drop_fraction);
         let n = scan.ranges.len();
         if n == 0 {
@@ -482,7 +503,7 @@ mod test {
                 end: e,
                 mount,
             };
-            cloud.clear_seen_through(&scan, cfg.clear_margin_m)
+            cloud.clear_seen_through(&scan, cfg.clear_margin_m, cfg.clear_beyond_rays)
         };
         let mut kept = c.clone();
         clear(&mut kept, true);
@@ -493,19 +514,55 @@ mod test {
     }
 
     #[test]
-    fn no_return_says_nothing() {
-        let mut c = GlobalCloud::new();
+    fn no_return_alone_says_nothing() {
         let cfg = CloudConfig::default();
-        c.add_scan(&still(&with_box(), Pose2::IDENTITY), &cfg);
+        let mut boxed = GlobalCloud::new();
+        boxed.add_scan(&still(&with_box(), Pose2::IDENTITY), &cfg);
         // A dark box: its bins return nothing. The wall beside it returns as before.
         let mut dark = scan_of(3.0);
         for d in (355..360).chain(0..6) {
             dark[d] = 0.0;
         }
+        let mut c = boxed.clone();
         assert_eq!(
-            c.clear_seen_through(&still(&dark, Pose2::IDENTITY), 0.15),
+            c.clear_seen_through(&still(&dark, Pose2::IDENTITY), 0.15, 4),
             0
         );
+        // When one ray from beyond is enough, only the box's two edge points go (a ray beside
+        // each reaches the wall); its inner nine, with nothing but silence around them, stay.
+        // When two are, one edge goes (the four rays of a point are its bin, the one before
+        // and the two after); when three are, none.
+        for (beyond, gone) in [(1, 2), (2, 1), (3, 0)] {
+            let mut c = boxed.clone();
+            assert_eq!(
+                c.clear_seen_through(&still(&dark, Pose2::IDENTITY), 0.15, beyond),
+                gone
+            );
+            assert_eq!(c.iter().filter(|p| p.norm() < 1.5).count(), 11 - gone);
+        }
+    }
+
+    #[test]
+    fn legs_seen_against_open_space_are_forgotten() {
+        // Legs 1 m ahead, then gone: beyond them a doorway onto space past the range, whose
+        // rays return nothing or, here and there, from far beyond.
+        let cfg = CloudConfig::default();
+        let mut legs = scan_of(3.0);
+        for d in (357..360).chain(0..4) {
+            legs[d] = 1.0;
+        }
+        let mut open = scan_of(3.0);
+        for d in (350..360).chain(0..11) {
+            open[d] = if d % 2 == 0 { 4.2 } else { 0.0 };
+        }
+        let near = |c: &GlobalCloud| c.iter().filter(|p| p.norm() < 1.5).count();
+        for (beyond, left) in [(4, 7), (3, 7), (2, 0), (1, 0)] {
+            let mut c = GlobalCloud::new();
+            c.add_scan(&still(&legs, Pose2::IDENTITY), &cfg);
+            assert_eq!(near(&c), 7);
+            c.clear_seen_through(&still(&open, Pose2::IDENTITY), 0.15, beyond);
+            assert_eq!(near(&c), left, "rays from beyond needed: {beyond}");
+        }
     }
 
     /// Ranges from the origin to the line y = `y` (bins whose rays meet it within 3.5 m).
@@ -538,11 +595,13 @@ mod test {
         for k in 1..=5 {
             let next = Pose2::new(0.013 * k as f32, 0.0, 0.0031 * k as f32);
             let ranges = wall_at(0.3, next);
-            assert_eq!(
-                c.clear_seen_through(&still(&ranges, next), 0.15),
-                0,
-                "step {k}"
-            );
+            for beyond in 1..=4 {
+                assert_eq!(
+                    c.clear_seen_through(&still(&ranges, next), 0.15, beyond),
+                    0,
+                    "step {k}, rays from beyond needed: {beyond}"
+                );
+            }
         }
     }
 

@@ -50,6 +50,7 @@
 //! enabled = true
 //! drop_fraction = 0.05         # oldest share of the cloud dropped every revolution
 //! clear_margin_m = 0.15        # forget points the rays pass beyond by this + 3 % (0: never)
+//! clear_beyond_rays = 4        # of the 4 rays round a point, how many pass beyond it (1–4)
 //! eps_min_m = 0.08             # adaptive DBSCAN radius bounds
 //! eps_max_m = 0.32
 //! min_samples = 10
@@ -231,6 +232,10 @@ pub struct MethodASettings {
     /// Points the rays around their bearing pass beyond by this (plus 3 % of their range)
     /// are forgotten, m; 0: only aging forgets (`perception::cloud`).
     pub clear_margin_m: f32,
+    /// Of the four rays around a point's bearing, how many must return from beyond it for it
+    /// to be forgotten, the others returning nothing (1–4; 4: a ray that returned nothing says
+    /// nothing; `perception::cloud`): legs that walked past a doorway are forgotten.
+    pub clear_beyond_rays: u8,
     /// Smallest DBSCAN radius, m.
     pub eps_min_m: f32,
     /// Largest DBSCAN radius, m.
@@ -266,6 +271,7 @@ impl Default for MethodASettings {
             enabled: true,
             drop_fraction: d.cloud.drop_fraction,
             clear_margin_m: d.cloud.clear_margin_m,
+            clear_beyond_rays: d.cloud.clear_beyond_rays,
             eps_min_m: d.dbscan.eps_min_m,
             eps_max_m: d.dbscan.eps_max_m,
             min_samples: d.dbscan.min_samples,
@@ -442,6 +448,12 @@ impl Config {
         let within = |name: &str, v: f32, lo: f32, hi: f32| within("method_a", name, v, lo, hi);
         within("drop_fraction", a.drop_fraction, 0.0, 1.0)?;
         within("clear_margin_m", a.clear_margin_m, 0.0, 10.0)?;
+        within(
+            "clear_beyond_rays",
+            f32::from(a.clear_beyond_rays),
+            1.0,
+            4.0,
+        )?;
         within("eps_min_m", a.eps_min_m, 0.01, 2.0)?;
         within("eps_max_m", a.eps_max_m, a.eps_min_m, 2.0)?;
         within("merge_link_m", a.merge_link_m, 0.0, 5.0)?;
@@ -574,6 +586,17 @@ mod test {
             bad.validate()
                 .unwrap_err()
                 .contains("method_a.door_max_gap_m")
+        );
+        // How many of the rays round a cloud point must return from beyond it: 1–4.
+        let a: Config = toml::from_str("[method_a]\nclear_beyond_rays = 2\n").unwrap();
+        a.validate().unwrap();
+        assert_eq!(a.method_a().cloud.clear_beyond_rays, 2);
+        assert_eq!(Config::default().method_a().cloud.clear_beyond_rays, 4);
+        let bad: Config = toml::from_str("[method_a]\nclear_beyond_rays = 0\n").unwrap();
+        assert!(
+            bad.validate()
+                .unwrap_err()
+                .contains("method_a.clear_beyond_rays")
         );
         let bad: Config = toml::from_str("[world]\nmin_likelihood = 1.5\n").unwrap();
         assert!(bad.validate().unwrap_err().contains("world.min_likelihood"));

@@ -76,6 +76,7 @@ impl Config {
         let mut c = MethodAConfig::default();
         c.cloud.drop_fraction = a.drop_fraction;
         c.cloud.clear_margin_m = a.clear_margin_m;
+        c.cloud.clear_beyond_rays = a.clear_beyond_rays;
         c.cloud.range_min_m = self.lidar.min_range_m;
         c.cloud.range_max_m = self.lidar.max_range_m;
         c.dbscan.eps_min_m = a.eps_min_m;
