@@ -119,9 +119,9 @@ fn bench(c: &mut Criterion) {
         end: perception::geometry::Pose2::new(sensor.x, sensor.y, 0.05),
         mount: perception::geometry::Pose2::IDENTITY,
     };
-    let (margin, none) = (cfg.cloud.clear_margin_m, cfg.cloud.clear_beyond_rays);
+    let (margin, beyond) = (cfg.cloud.clear_margin_m, cfg.cloud.clear_beyond_rays);
     g.bench_function("cloud_clear", |b| {
-        b.iter(|| cloud.clear_seen_through(black_box(&scan), margin, none))
+        b.iter(|| cloud.clear_seen_through(black_box(&scan), margin, beyond))
     });
     let mut copy = base.clone();
     g.bench_function("clone_state_for_reference", |b| {
@@ -135,7 +135,7 @@ fn bench(c: &mut Criterion) {
     let ours_full = time(&mut || m2.run(sensor, &cfg, forest));
     let ours_dbscan = time(&mut || d.run(&points, &cfg.dbscan));
     let ours_clear = time(&mut || {
-        cloud.clear_seen_through(&scan, margin, none);
+        cloud.clear_seen_through(&scan, margin, beyond);
     });
     println!(
         "ours: pipeline run {ours_full:.4} ms, DBSCAN {ours_dbscan:.4} ms, clearing the cloud \

@@ -265,9 +265,9 @@ impl GlobalCloud {
             let mut past = 0;
             let all = (first_bin..first_bin + 4).all(|d| {
                 let r = scan.ranges[d % n];
-                let beyond = r.is_finite() && r > beyond;
-                past += usize::from(beyond);
-                beyond || r == 0.0
+                let past_it = r.is_finite() && r > beyond;
+                past += usize::from(past_it);
+                past_it || r == 0.0
             });
             all && past >= beyond_rays
         };
