@@ -639,6 +639,10 @@ mod test {
         assert_eq!(Config::default().world.tracks(true).appeared_settle_s, 3.0);
         let w: Config = toml::from_str("[world]\nappeared_settle_s = 0\n").unwrap();
         assert_eq!(w.world.tracks(true).appeared_settle_s, 0.0);
+        assert_eq!(Config::default().world.tracks(true).seen_through_revs, 2);
+        let w: Config = toml::from_str("[world]\nseen_through_revs = 0\n").unwrap();
+        assert_eq!(w.world.tracks(true).seen_through_revs, 0);
+        assert!(toml::from_str::<Config>("[world]\nseen_through_revs = 300\n").is_err());
         assert_eq!(Config::default().world.tracks(true).miss_min_returns, 2);
         let w: Config = toml::from_str("[world]\nmiss_min_returns = 3\n").unwrap();
         assert_eq!(w.world.tracks(true).miss_min_returns, 3);

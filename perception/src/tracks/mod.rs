@@ -159,6 +159,11 @@ pub struct TrackConfig {
     /// stands for a moment, not where furniture stood when the robot first looked. Below
     /// [`MotionConfig::settle_s`]: no extra wait.
     pub appeared_settle_s: f32,
+    /// Revolutions in a row a track born on floor seen empty must be detected while its own
+    /// footprint is seen empty (every ray across it returning from beyond) before that counts
+    /// against it as if it had gone unseen (`free_loss`): legs that stood there and walked on,
+    /// their detections now matched from beside the place. 0: never.
+    pub seen_through_revs: u8,
 }
 
 impl Default for TrackConfig {
@@ -188,6 +193,7 @@ impl Default for TrackConfig {
             report_model: None,
             door_hold_hits: 0,
             appeared_settle_s: 0.0,
+            seen_through_revs: 0,
         }
     }
 }
@@ -231,6 +237,9 @@ pub struct Track {
     /// Furniture that appeared on floor seen empty before ([`FreeFloor`]): it waits
     /// [`TrackConfig::appeared_settle_s`] before it is reported.
     pub born_on_free: bool,
+    /// Revolutions in a row it was detected while its footprint was seen empty
+    /// ([`TrackConfig::seen_through_revs`]).
+    pub seen_through: u8,
     /// A door frame the map's walls have shown as a doorway (a gap seen through): an opening
     /// in a wall, which rays passing through do not speak against.
     pub anchored: bool,
@@ -416,6 +425,8 @@ impl Tracks {
             for (i, t) in self.tracks.iter_mut().enumerate() {
                 if !matched[i] {
                     negative::unobserved(t, lidar, ranges, looked, trust_none, cfg);
+                } else if trust_none && t.born_on_free && cfg.seen_through_revs > 0 {
+                    negative::seen_through(t, lidar, ranges, cfg);
                 }
             }
         }
@@ -459,6 +470,7 @@ impl Tracks {
                 width_m: 0.0,
                 motion: Motion::new(o.centre, stamp_s),
                 born_on_free: o.class != ObjectClass::DoorFrame && self.floor.seen_free(o.centre),
+                seen_through: 0,
                 anchored: false,
                 box_wide_views: 0,
                 narrow_views: 0,
@@ -1783,6 +1795,58 @@ mod test {
             step(&mut t, f, &door, &Pose2::IDENTITY, &seen_through, &cfg);
         }
         assert!(t.confirmed().next().is_some());
+    }
+
+    #[test]
+    fn legs_that_stood_and_walked_on_leave_though_detected_beside_their_place() {
+        let cfg = TrackConfig {
+            appeared_settle_s: 3.0,
+            seen_through_revs: 2,
+            ..TrackConfig::default()
+        };
+        let passed = ranges(3.4);
+        // Legs standing 2 m ahead: their rays return at 1.9–2.1 m.
+        let mut legs = ranges(3.4);
+        for d in [357usize, 358, 2, 3] {
+            legs[d] = 2.0;
+        }
+        let here = [obs(ObjectClass::Box, 2.0, 0.0, 0.8, Evidence::AB)];
+        // The person walks on in a small loop: detections 0.35 m aside, within the gate,
+        // while the rays across the place itself return from the wall behind.
+        let beside = [obs(ObjectClass::Box, 2.0, 0.35, 0.8, Evidence::AB)];
+        let run = |cfg: &TrackConfig, gone_every: u64| {
+            let mut t = Tracks::new();
+            for f in 0..10 {
+                step(&mut t, f, &[], &Pose2::IDENTITY, &passed, cfg);
+            }
+            for f in 10..30 {
+                step(&mut t, f, &here, &Pose2::IDENTITY, &legs, cfg);
+            }
+            assert!(t.all()[0].born_on_free, "appeared on floor seen empty");
+            let start = t.all()[0].existence;
+            for f in 30..50 {
+                // Every `gone_every`-th revolution shows the place empty; the others, legs.
+                let scan = if f % gone_every == 0 { &passed } else { &legs };
+                step(&mut t, f, &beside, &Pose2::IDENTITY, scan, cfg);
+            }
+            (start, t.all().first().map(|tr| tr.existence))
+        };
+        // The place seen empty in every revolution: the track dies though still matched.
+        let (start, end) = run(&cfg, 1);
+        assert!(
+            end.is_none_or(|e| e < cfg.confirm_existence),
+            "{start} → {end:?}"
+        );
+        // Seen empty only in every other revolution (legs between): nothing said.
+        let (start, end) = run(&cfg, 2);
+        assert!(end.is_some_and(|e| e >= start), "{start} → {end:?}");
+        // Off: the detections beside keep it.
+        let off = TrackConfig {
+            seen_through_revs: 0,
+            ..cfg
+        };
+        let (start, end) = run(&off, 1);
+        assert!(end.is_some_and(|e| e >= start), "{start} → {end:?}");
     }
 
     #[test]

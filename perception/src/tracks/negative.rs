@@ -12,6 +12,10 @@
 //!   rate either. Nor is it missed where its footprint returned fewer rays than
 //!   [`TrackConfig::miss_min_returns`] (too few for a method to find it by), unless it was
 //!   born on floor seen empty.
+//!
+//! And one for a track it did observe: furniture born on floor seen empty whose footprint the
+//! rays pass while its detections go on beside it ([`seen_through`]): legs that stood there a
+//! moment and walked on.
 
 use super::{Track, TrackConfig};
 use crate::class::ObjectClass;
@@ -113,5 +117,22 @@ pub(super) fn unobserved(
     if t.existence < cfg.confirm_existence {
         // Reported again only once the evidence is back.
         t.confirmed = false;
+    }
+}
+
+/// A track born on free floor and detected this frame: if its footprint is seen empty in
+/// [`TrackConfig::seen_through_revs`] revolutions in a row, it loses `free_loss` as if unseen.
+pub(super) fn seen_through(t: &mut Track, lidar: &Pose2, ranges: &[f32; BINS], cfg: &TrackConfig) {
+    if footprint_view(t.centre, t.radius(), lidar, ranges, cfg.max_range_m) != View::Empty {
+        t.seen_through = 0;
+        return;
+    }
+    t.seen_through = t.seen_through.saturating_add(1);
+    if t.seen_through >= cfg.seen_through_revs {
+        t.tally.unobserved(true);
+        t.existence = (t.existence - cfg.free_loss).max(-cfg.existence_cap);
+        if t.existence < cfg.confirm_existence {
+            t.confirmed = false;
+        }
     }
 }
