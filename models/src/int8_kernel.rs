@@ -294,14 +294,16 @@ mod tests {
             .collect()
     }
 
-    /// `C = A · B` (A `m × k`, B `k × n`, i8) by `mmm`'s i8 packing, then `after`, stored as i32.
+    /// `C = A · B` (A `m × k`, B `k × n`, i8, row-major) by `mmm`'s i8 packing, then
+    /// `after`, stored as i32.
     fn product(
         mmm: &dyn MatMatMul,
         (m, k, n): (usize, usize, usize),
+        (a, b): (&[i8], &[i8]),
         after: &[FusedSpec],
     ) -> Vec<i32> {
-        let a = Tensor::from_shape(&[m, k], &bytes(m * k, 7)).unwrap();
-        let b = Tensor::from_shape(&[k, n], &bytes(k * n, 11)).unwrap();
+        let a = Tensor::from_shape(&[m, k], a).unwrap();
+        let b = Tensor::from_shape(&[k, n], b).unwrap();
         let (pack_a, pack_b) = &mmm.packings()[I8_PACKING];
         let pa = pack_a.prepare_one(&a, 1, 0).unwrap();
         let pb = pack_b.prepare_one(&b, 0, 1).unwrap();
@@ -327,7 +329,8 @@ mod tests {
             .to_vec()
     }
 
-    fn reference((m, k, n): (usize, usize, usize)) -> Vec<i32> {
+    /// The operands of a shape (deterministic) and their exact product.
+    fn operands((m, k, n): (usize, usize, usize)) -> (Vec<i8>, Vec<i8>, Vec<i32>) {
         let (a, b) = (bytes(m * k, 7), bytes(k * n, 11));
         let mut c = vec![0i32; m * n];
         for r in 0..m {
@@ -337,7 +340,7 @@ mod tests {
                     .sum();
             }
         }
-        c
+        (a, b, c)
     }
 
     const SHAPES: [(usize, usize, usize); 5] = [
@@ -355,39 +358,17 @@ mod tests {
         }
         let ours = kernel_object();
         for shape in SHAPES {
-            assert_eq!(product(&ours, shape, &[]), reference(shape), "{shape:?}");
+            let (a, b, c) = operands(shape);
+            assert_eq!(product(&ours, shape, (&a, &b), &[]), c, "{shape:?}");
         }
-        // The most negative products (-128 · -128, summed) stay exact.
+        // The largest products (-128 · -128, summed) stay exact.
         let (m, k, n) = (8, 64, 4);
-        let a = Tensor::from_shape(&[m, k], &vec![-128i8; m * k]).unwrap();
-        let b = Tensor::from_shape(&[k, n], &vec![-128i8; k * n]).unwrap();
-        let (pack_a, pack_b) = &ours.packings()[I8_PACKING];
-        let (pa, pb) = (
-            pack_a.prepare_one(&a, 1, 0).unwrap(),
-            pack_b.prepare_one(&b, 0, 1).unwrap(),
+        let c = product(
+            &ours,
+            (m, k, n),
+            (&vec![-128; m * k], &vec![-128; k * n]),
+            &[],
         );
-        let mut c = Tensor::zero::<i32>(&[m, n]).unwrap();
-        // SAFETY: as in `product`.
-        let store = unsafe {
-            ours.c_from_data_and_strides(4, n as isize, 1)
-                .wrap(&c.view_mut())
-        };
-        let specs = [
-            FusedSpec::AddMatMul {
-                a: AsInputValue::Borrowed(&*pa),
-                b: AsInputValue::Borrowed(&*pb),
-                packing: I8_PACKING,
-            },
-            FusedSpec::Store(store),
-        ];
-        // SAFETY: as in `product`.
-        unsafe { ours.run(m, n, &specs).unwrap() };
-        let c = c
-            .try_as_plain_ram()
-            .unwrap()
-            .as_slice::<i32>()
-            .unwrap()
-            .to_vec();
         assert!(c.iter().all(|&x| x == 64 * 128 * 128), "{c:?}");
     }
 
@@ -403,13 +384,15 @@ mod tests {
             FusedSpec::BinScalar(&minus_five, BinOp::Add),
         ];
         for shape in SHAPES {
-            let expected: Vec<i32> = reference(shape).iter().map(|x| x * 3 - 5).collect();
-            assert_eq!(product(&ours, shape, &after), expected, "{shape:?}");
+            let (a, b, c) = operands(shape);
+            let expected: Vec<i32> = c.iter().map(|x| x * 3 - 5).collect();
             assert_eq!(
-                product(&*theirs, shape, &after),
+                product(&ours, shape, (&a, &b), &after),
                 expected,
-                "tract's, {shape:?}"
+                "{shape:?}"
             );
+            let tracts = product(&*theirs, shape, (&a, &b), &after);
+            assert_eq!(tracts, expected, "tract's, {shape:?}");
         }
     }
 }
