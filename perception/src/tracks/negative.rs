@@ -113,9 +113,14 @@ pub(super) fn unobserved(
     if in_view {
         t.views = t.views.saturating_add(1);
     }
+    lose(t, loss, cfg);
+}
+
+/// `t`'s existence falls by `loss` (within the cap); below the confirmation level it is no
+/// longer reported, until the evidence is back.
+fn lose(t: &mut Track, loss: f32, cfg: &TrackConfig) {
     t.existence = (t.existence - loss).max(-cfg.existence_cap);
     if t.existence < cfg.confirm_existence {
-        // Reported again only once the evidence is back.
         t.confirmed = false;
     }
 }
@@ -130,9 +135,6 @@ pub(super) fn seen_through(t: &mut Track, lidar: &Pose2, ranges: &[f32; BINS], c
     t.seen_through = t.seen_through.saturating_add(1);
     if t.seen_through >= cfg.seen_through_revs {
         t.tally.unobserved(true);
-        t.existence = (t.existence - cfg.free_loss).max(-cfg.existence_cap);
-        if t.existence < cfg.confirm_existence {
-            t.confirmed = false;
-        }
+        lose(t, cfg.free_loss, cfg);
     }
 }
