@@ -154,6 +154,16 @@ fn buffers_in_code() -> Vec<(&'static str, usize, usize)> {
             size_of::<perception::tracks::ReportModel>(),
         ),
         (
+            "perception::tracks::MAX_PAIRS",
+            perception::tracks::MAX_PAIRS,
+            size_of::<(f32, u16, u16)>(),
+        ),
+        (
+            "perception::tracks::MAX_TAKEN",
+            perception::tracks::MAX_TAKEN,
+            size_of::<(u16, u16)>(),
+        ),
+        (
             "perception::tracks::MAX_WALKERS",
             perception::tracks::MAX_WALKERS,
             size_of::<perception::tracks::Walker>(),

@@ -56,7 +56,8 @@ use crate::geometry::{Point2, Pose2};
 use crate::motion::{Motion, MotionConfig};
 use crate::outline_average::AveragedOutline;
 use crate::sight::BINS;
-use association::{cheapest, class_cost};
+pub use association::{MAX_PAIRS, MAX_TAKEN};
+use association::{class_cost, greedy};
 use belief::class_radius;
 pub use outline_marks::{
     AVERAGED_ROUND_MAJORITY, AVERAGED_ROUND_VIEWS, OUTLINE_SLOTS, averaged_vote,
@@ -383,25 +384,33 @@ impl Tracks {
             *a = t.motion.predict(stamp_s, &cfg.motion);
         }
         // Greedy on the global minimum cost.
-        while let Some((i, k)) = cheapest(&matched, &used, self.tracks.len(), obs.len(), |i, k| {
-            let (t, o) = (&self.tracks[i], &obs[k]);
-            // Looked for where it stands, or where its walk has taken it.
-            let d = t.centre.distance(o.centre).min(ahead[i].distance(o.centre));
-            // A desk's centre moves with the view more than a chair's (its legs come and go
-            // behind each other): desks gate at their own radius.
-            let desks = t.class() == ObjectClass::Desk && o.class == ObjectClass::Desk;
-            let gate = if desks {
-                cfg.gate_m.max(class_radius(ObjectClass::Desk))
-            } else {
-                cfg.gate_m
-            };
-            if d > gate {
-                return None;
-            }
-            class_cost(t.class(), o.class, cfg).map(|extra| d + extra)
-        }) {
-            matched[i] = true;
-            used[k] = true;
+        let taken = greedy(
+            &mut matched,
+            &mut used,
+            self.tracks.len(),
+            obs.len(),
+            |i, k| {
+                let (t, o) = (&self.tracks[i], &obs[k]);
+                // Looked for where it stands, or where its walk has taken it.
+                let d = t.centre.distance(o.centre).min(ahead[i].distance(o.centre));
+                // A desk's centre moves with the view more than a chair's (its legs come and go
+                // behind each other): desks gate at their own radius.
+                let desks = t.class() == ObjectClass::Desk && o.class == ObjectClass::Desk;
+                let gate = if desks {
+                    cfg.gate_m.max(class_radius(ObjectClass::Desk))
+                } else {
+                    cfg.gate_m
+                };
+                if d > gate {
+                    return None;
+                }
+                class_cost(t.class(), o.class, cfg).map(|extra| d + extra)
+            },
+        );
+        for (i, k) in taken
+            .into_iter()
+            .map(|(i, k)| (usize::from(i), usize::from(k)))
+        {
             // Only a desk, or a track this observation may make one, is asked (`report.rs`).
             let desk = ObjectClass::Desk;
             let beside = (self.tracks[i].class() == desk || obs[k].class == desk)

@@ -92,8 +92,12 @@ impl Walkers {
         for (a, w) in ahead.iter_mut().zip(self.list.iter()) {
             *a = w.motion.predict(stamp_s, cfg);
         }
-        while let Some((i, k)) =
-            super::association::cheapest(&matched, &used, self.list.len(), persons.len(), |i, k| {
+        let taken = super::association::greedy(
+            &mut matched,
+            &mut used,
+            self.list.len(),
+            persons.len(),
+            |i, k| {
                 let (w, p) = (&self.list[i], &persons[k]);
                 let d = w
                     .motion
@@ -101,10 +105,12 @@ impl Walkers {
                     .distance(p.centre)
                     .min(ahead[i].distance(p.centre));
                 (d <= WALKER_GATE_M).then_some(d)
-            })
+            },
+        );
+        for (i, k) in taken
+            .into_iter()
+            .map(|(i, k)| (usize::from(i), usize::from(k)))
         {
-            matched[i] = true;
-            used[k] = true;
             let w = &mut self.list[i];
             w.motion.observe(persons[k].centre, stamp_s, cfg, true);
             w.hits = w.hits.saturating_add(1);
