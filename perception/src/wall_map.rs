@@ -55,6 +55,13 @@ pub const DOOR_LINE_M: f32 = 0.2;
 /// … and no farther beyond the line's end than half the widest doorway (0.7 m) and a jamb's
 /// allowance, m.
 pub const DOOR_REACH_M: f32 = 0.9;
+/// [`WallMap::far_jamb`] looks for the other jamb of a door frame this close to a confirmed
+/// line, m: wider than [`DOOR_LINE_M`], since a door frame a method places at a wall's end
+/// that is no doorway (an L-shaped room's protruding corner, a partition's free end) sits
+/// beside the line as often as in it, and only the other jamb's place seen empty speaks
+/// against it (tuning seeds: the varied family's phantoms 0.293 → 0.273 a frame, no door lost;
+/// `docs/world.md`, 46th session).
+pub const FAR_JAMB_LINE_M: f32 = 0.3;
 /// Narrowest doorway [`WallMap::far_jamb`] assumes, m.
 pub const MIN_DOOR_M: f32 = 0.75;
 /// Widest doorway [`WallMap::far_jamb`] assumes, m.
@@ -406,7 +413,7 @@ impl WallMap {
     }
 
     /// Where a doorway's other jamb would stand if `p` were the middle of a doorway beside the
-    /// end of a confirmed line: `p` in that line ([`DOOR_LINE_M`]) and past the end by at most
+    /// end of a confirmed line: `p` in or beside that line ([`FAR_JAMB_LINE_M`]) and past the end by at most
     /// [`DOOR_REACH_M`]; the end is one jamb, and the other stands as far again past `p`, a
     /// doorway's width ([`MIN_DOOR_M`]–[`MAX_DOOR_M`]) from the end, in the line. `None` when
     /// `p` stands past no line's end.
@@ -415,7 +422,7 @@ impl WallMap {
             return None;
         }
         self.walls.iter().filter(|w| w.confirmed()).find_map(|w| {
-            if libm::fabsf(w.in_front(p)) > DOOR_LINE_M {
+            if libm::fabsf(w.in_front(p)) > FAR_JAMB_LINE_M {
                 return None;
             }
             let u = w.along(p);
@@ -529,6 +536,10 @@ mod test {
         assert!(near(map.far_jamb(Point2::new(0.85, 2.0)), 1.3, 2.0));
         // Past the other end: the jamb lies that way.
         assert!(near(map.far_jamb(Point2::new(-3.4, 1.95)), -3.8, 2.0));
+        // Beside the line rather than in it (a door frame placed at an L's protruding corner):
+        // the jamb is looked for all the same, along the line.
+        assert!(near(map.far_jamb(Point2::new(0.2, 2.25)), 0.75, 2.0));
+        assert!(near(map.far_jamb(Point2::new(0.2, 1.75)), 0.75, 2.0));
         // In the wall's extent, off its line, too far past its end, or not a number: none.
         for p in [(-1.0, 2.0), (0.45, 1.6), (1.0, 2.0), (f32::NAN, 2.0)] {
             assert_eq!(map.far_jamb(Point2::new(p.0, p.1)), None, "{p:?}");
