@@ -16,7 +16,8 @@ use super::{MAX_TRACKS, TrackConfig};
 use crate::class::ObjectClass;
 
 /// Gated (track, observation) pairs sorted at once, at most: a frame gives a few per
-/// observation (20–40 observations, 40–64 tracks); more go the slow way ([`cheapest`]).
+/// observation (20–40 observations, 40–64 tracks); more go the slow way (the cheapest free
+/// pair looked for again after each take).
 pub const MAX_PAIRS: usize = 512;
 
 /// Pairs taken in one frame, at most: one per track.
