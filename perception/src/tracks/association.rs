@@ -52,11 +52,11 @@ pub(super) fn greedy(
     if overflow {
         let finite = |i, k| cost(i, k).filter(|c: &f32| c.is_finite());
         while let Some((i, k)) = cheapest(matched, used, tracks, obs, finite) {
-            matched[i] = true;
-            used[k] = true;
             if taken.push((i as u16, k as u16)).is_err() {
                 break;
             }
+            matched[i] = true;
+            used[k] = true;
         }
         return taken;
     }
@@ -66,11 +66,11 @@ pub(super) fn greedy(
         if matched[iu] || used[ku] {
             continue;
         }
+        if taken.push((i, k)).is_err() {
+            break; // more pairs than tracks cannot be; none is marked that is not taken
+        }
         matched[iu] = true;
         used[ku] = true;
-        if taken.push((i, k)).is_err() {
-            break;
-        }
     }
     taken
 }
