@@ -36,12 +36,13 @@ pub(super) fn greedy(
     cost: impl Fn(usize, usize) -> Option<f32>,
 ) -> Vec<(u16, u16), MAX_TAKEN> {
     let (tracks, obs) = (tracks.min(matched.len()), obs.min(used.len()));
+    let finite = |i, k| cost(i, k).filter(|c: &f32| c.is_finite());
     let mut taken = Vec::new();
     let mut pairs: Vec<(f32, u16, u16), MAX_PAIRS> = Vec::new();
     let mut overflow = false;
     'fill: for i in (0..tracks).filter(|&i| !matched[i]) {
         for k in (0..obs).filter(|&k| !used[k]) {
-            if let Some(c) = cost(i, k).filter(|c| c.is_finite())
+            if let Some(c) = finite(i, k)
                 && pairs.push((c, i as u16, k as u16)).is_err()
             {
                 overflow = true;
@@ -50,7 +51,6 @@ pub(super) fn greedy(
         }
     }
     if overflow {
-        let finite = |i, k| cost(i, k).filter(|c: &f32| c.is_finite());
         while let Some((i, k)) = cheapest(matched, used, tracks, obs, finite) {
             if taken.push((i as u16, k as u16)).is_err() {
                 break;
