@@ -414,9 +414,9 @@ impl WallMap {
 
     /// Where a doorway's other jamb would stand if `p` were the middle of a doorway beside the
     /// end of a confirmed line: `p` in or beside that line ([`FAR_JAMB_LINE_M`]) and past the
-    /// end by at most [`DOOR_REACH_M`]; the end is one jamb, and the other stands as far again past `p`, a
-    /// doorway's width ([`MIN_DOOR_M`]–[`MAX_DOOR_M`]) from the end, in the line. `None` when
-    /// `p` stands past no line's end.
+    /// end by at most [`DOOR_REACH_M`]; the end is one jamb, and the other stands as far again
+    /// past `p`, a doorway's width ([`MIN_DOOR_M`]–[`MAX_DOOR_M`]) from the end, in the line.
+    /// `None` when `p` stands past no line's end.
     pub fn far_jamb(&self, p: Point2) -> Option<Point2> {
         if !(p.x.is_finite() && p.y.is_finite()) {
             return None;
