@@ -20,6 +20,8 @@
 //! * `umbra-lab eval-world [--family sim|annex|both] [--runs 12] [--world on|off|both]`
 //!   replays held-out runs of both scene families through the `umbra` binary and scores its
 //!   world (`docs/world.md`).
+//! * `umbra-lab compare BASE.json… [--with OTHER.json…]` sets two settings' `eval-world --json`
+//!   results side by side, run by run, with a paired bootstrap interval for each difference.
 //!
 //! Regenerating the committed forest is the two commands `forest-data` and `forest-train` with
 //! their defaults; both are deterministic.
@@ -216,6 +218,24 @@ enum Command {
         #[arg(long)]
         track_logs: bool,
     },
+    /// Compares two settings' `eval-world --json` results run by run (the same seeds, in the
+    /// same order): each figure's difference and its 95 % interval from a paired bootstrap
+    /// over runs, and whether that is more than the runs' scatter. Without `--with`, each
+    /// figure of the first set with its own interval.
+    Compare {
+        /// The base setting's `eval-world --json` files.
+        #[arg(required = true)]
+        base: Vec<PathBuf>,
+        /// The other setting's files, one for each base file, in the same order.
+        #[arg(long, num_args = 1..)]
+        with: Vec<PathBuf>,
+        /// Bootstrap draws.
+        #[arg(long, default_value_t = 4000)]
+        resamples: usize,
+        /// Seed of the draws.
+        #[arg(long, default_value_t = 1)]
+        seed: u64,
+    },
 }
 
 #[derive(Clone, Copy, ValueEnum)]
@@ -329,6 +349,23 @@ fn run(cli: Cli) -> Result<(), String> {
             }
             std::fs::write(&out, text).map_err(|e| format!("{}: {e}", out.display()))?;
             println!("{}: {counts:?}", out.display());
+        }
+        Command::Compare {
+            base,
+            with,
+            resamples,
+            seed,
+        } => {
+            use lab::world_eval::compare::{compare, load, report};
+            if !with.is_empty() && with.len() != base.len() {
+                return Err(format!(
+                    "{} base files and {} --with files: give one for each",
+                    base.len(),
+                    with.len()
+                ));
+            }
+            let rows = compare(&load(&base)?, &load(&with)?, resamples, seed)?;
+            print!("{}", report(&rows));
         }
         Command::Calibrate { json, out, made_by } => {
             let text = lab::world_eval::calibration_counts(&json, &made_by)?;

@@ -8,6 +8,7 @@
 //! world model on or off; the output lines are scored by [`score`].
 
 mod assignment;
+pub mod compare;
 mod describe;
 pub mod fates;
 mod line;
