@@ -40,7 +40,7 @@ pub struct Figure {
 }
 
 /// The figures compared, in report order.
-pub const FIGURES: [Figure; 6] = [
+pub const FIGURES: [Figure; 7] = [
     Figure {
         name: "phantoms per frame",
         parts: |t| {
@@ -49,6 +49,11 @@ pub const FIGURES: [Figure; 6] = [
                 f64::from(t.frames),
             )
         },
+        lower_is_better: true,
+    },
+    Figure {
+        name: "phantom objects per run",
+        parts: |t| (f64::from(t.phantom_objects), f64::from(t.runs)),
         lower_is_better: true,
     },
     Figure {

@@ -351,6 +351,11 @@ pub fn report(outcomes: &[Outcome]) -> String {
         );
         let _ = writeln!(
             s,
+            "    phantom objects (distinct ids, each counted once) {:.2}/run",
+            f64::from(t.phantom_objects) / f64::from(t.runs.max(1))
+        );
+        let _ = writeln!(
+            s,
             "    of them within 0.15 m of a wall face {:.3}/frame; by class chair {:.3}, box {:.3}, desk {:.3}, door frame {:.3}",
             f64::from(t.phantoms_at_wall) / f,
             f64::from(t.phantoms_by_class[0]) / f,

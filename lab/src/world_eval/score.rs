@@ -47,6 +47,11 @@ pub struct Tally {
     pub door_frames_found: u32,
     /// Reported objects per frame that lie on no furniture and no door, by source A, B, AB.
     pub phantoms: [u32; 3],
+    /// Phantom objects: the distinct `objects` ids reported as a phantom in at least one frame
+    /// of a run, summed over runs. Phantoms per frame weighs each by how long it lived, and a
+    /// few long-lived ones make most of it; this counts each once.
+    #[serde(default)]
+    pub phantom_objects: u32,
     /// Phantoms (among `objects`) within 0.15 m of a wall face, and by class (chair, box, desk,
     /// door frame).
     pub phantoms_at_wall: u32,
@@ -158,6 +163,7 @@ pub fn score_run(truth: &RunTruth, lines: &[Line], tally: &mut Tally) {
     let mut co: Vec<Vec<i64>> = vec![Vec::new(); n_f];
     let mut last_match: Vec<Option<u64>> = vec![None; n_f];
     let mut last_pose_err = None;
+    let mut phantom_ids: Vec<u64> = Vec::new();
     for line in lines {
         let Some(fi) = truth.frame_at(line.t) else {
             continue;
@@ -199,6 +205,7 @@ pub fn score_run(truth: &RunTruth, lines: &[Line], tally: &mut Tally) {
                         {
                             phantoms[o.source] += 1;
                             if main {
+                                phantom_ids.push(o.id);
                                 tally.phantoms_by_class[3] += 1;
                                 tally.phantoms_where[phantom_place(truth, &alive, o.at)] += 1;
                             }
@@ -218,6 +225,7 @@ pub fn score_run(truth: &RunTruth, lines: &[Line], tally: &mut Tally) {
                         } else if near.peek().is_none() {
                             phantoms[o.source] += 1;
                             if main {
+                                phantom_ids.push(o.id);
                                 tally.phantoms_at_wall += u32::from(at_wall_face(truth, o.at));
                                 if let Some(c) = c {
                                     tally.phantoms_by_class[c as usize] += 1;
@@ -345,6 +353,9 @@ pub fn score_run(truth: &RunTruth, lines: &[Line], tally: &mut Tally) {
     }
     tally.idtp += max_assignment(&co) as u32;
     tally.final_position_err_m.extend(last_pose_err);
+    phantom_ids.sort_unstable();
+    phantom_ids.dedup();
+    tally.phantom_objects += phantom_ids.len() as u32;
 
     // Moves.
     for mv in &truth.moves {
@@ -473,6 +484,7 @@ impl Tally {
             runs,
             frames,
             door_frames_found,
+            phantom_objects,
             wrong_class,
             det_frames,
             id_gt,
@@ -779,6 +791,8 @@ mod test {
         // is one from frame 2 on, when the place was seen empty (in frame 1 nothing sensed
         // had said it went).
         assert_eq!(s.phantoms, [0, 4, 2]);
+        // Two objects, ids 4 and 5, over six phantom reports.
+        assert_eq!(s.phantom_objects, 2);
         assert_eq!(s.unrefuted, 1);
         assert_eq!(s.wrong_class, 4);
         assert_eq!(s.move_stuck, 1);
