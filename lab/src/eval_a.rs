@@ -425,6 +425,46 @@ impl Score {
     }
 }
 
+/// Method A scored with each merge guard alone, with none and with all (`eval-a
+/// --merge-guards`), as a Markdown table; `score` evaluates one configuration.
+pub fn merge_guard_table(acfg: &MethodAConfig, score: impl Fn(&MethodAConfig) -> Score) -> String {
+    let base = acfg.merge;
+    let variants = [
+        ("no guard", false, false, false),
+        ("legs only", true, false, false),
+        ("solid only", false, true, false),
+        ("extent only", false, false, true),
+        ("all guards", true, true, true),
+    ];
+    let mut out = String::from(
+        "\n| merge rule | candidates fusing distinct objects | split object-views | object accuracy | F1 chair / box / desk |\n|---|---|---|---|---|\n",
+    );
+    for (name, l, s, e) in variants {
+        let a = MethodAConfig {
+            merge: perception::merge::MergeConfig {
+                guard_legs: l,
+                guard_solid: s,
+                guard_extent: e,
+                ..base
+            },
+            ..*acfg
+        };
+        let sc = score(&a);
+        let (r, n) = sc.object_accuracy();
+        let f1: Vec<String> = sc.prf().iter().map(|x| format!("{:.4}", x.2)).collect();
+        let _ = writeln!(
+            out,
+            "| {name} | {} of {} | {} | {:.2} % | {} |",
+            sc.fused,
+            sc.candidates,
+            sc.split,
+            100.0 * f64::from(r) / f64::from(n.max(1)),
+            f1.join(" / ")
+        );
+    }
+    out
+}
+
 /// Runs `scenes` scenes and scores every view.
 pub fn evaluate(
     scenes: impl IntoIterator<Item = usize>,

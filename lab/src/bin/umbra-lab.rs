@@ -355,18 +355,10 @@ fn run(cli: Cli) -> Result<(), String> {
             with,
             resamples,
             seed,
-        } => {
-            use lab::world_eval::compare::{compare, load, report};
-            if !with.is_empty() && with.len() != base.len() {
-                return Err(format!(
-                    "{} base files and {} --with files: give one for each",
-                    base.len(),
-                    with.len()
-                ));
-            }
-            let rows = compare(&load(&base)?, &load(&with)?, resamples, seed)?;
-            print!("{}", report(&rows));
-        }
+        } => print!(
+            "{}",
+            lab::world_eval::compare::files(&base, &with, resamples, seed)?
+        ),
         Command::Calibrate { json, out, made_by } => {
             let text = lab::world_eval::calibration_counts(&json, &made_by)?;
             std::fs::write(&out, text).map_err(|e| format!("{}: {e}", out.display()))?;
@@ -506,39 +498,7 @@ fn run(cli: Cli) -> Result<(), String> {
                 }
             }
             if merge_guards {
-                let base = acfg.merge;
-                let variants = [
-                    ("no guard", false, false, false),
-                    ("legs only", true, false, false),
-                    ("solid only", false, true, false),
-                    ("extent only", false, false, true),
-                    ("all guards", true, true, true),
-                ];
-                println!(
-                    "\n| merge rule | candidates fusing distinct objects | split object-views | object accuracy | F1 chair / box / desk |\n|---|---|---|---|---|"
-                );
-                for (name, l, s, e) in variants {
-                    let a = MethodAConfig {
-                        merge: perception::merge::MergeConfig {
-                            guard_legs: l,
-                            guard_solid: s,
-                            guard_extent: e,
-                            ..base
-                        },
-                        ..acfg
-                    };
-                    let sc = eval(&a, forest);
-                    let (r, n) = sc.object_accuracy();
-                    let f1: Vec<String> = sc.prf().iter().map(|x| format!("{:.4}", x.2)).collect();
-                    println!(
-                        "| {name} | {} of {} | {} | {:.2} % | {} |",
-                        sc.fused,
-                        sc.candidates,
-                        sc.split,
-                        100.0 * f64::from(r) / f64::from(n.max(1)),
-                        f1.join(" / ")
-                    );
-                }
+                print!("{}", eval_a::merge_guard_table(&acfg, |a| eval(a, forest)));
             }
         }
         Command::PoseEval {

@@ -272,6 +272,29 @@ pub fn compare(
     Ok(rows)
 }
 
+/// `umbra-lab compare`: reads both sets of files (one `with` file for each base file, or none)
+/// and returns the Markdown table.
+pub fn files(
+    base: &[PathBuf],
+    with: &[PathBuf],
+    resamples: usize,
+    seed: u64,
+) -> Result<String, String> {
+    if !with.is_empty() && with.len() != base.len() {
+        return Err(format!(
+            "{} base files and {} --with files: give one for each",
+            base.len(),
+            with.len()
+        ));
+    }
+    Ok(report(&compare(
+        &load(base)?,
+        &load(with)?,
+        resamples,
+        seed,
+    )?))
+}
+
 /// The rows as a Markdown table.
 pub fn report(rows: &[Row]) -> String {
     let mut s = String::new();
