@@ -43,12 +43,7 @@ pub struct Figure {
 pub const FIGURES: [Figure; 7] = [
     Figure {
         name: "phantoms per frame",
-        parts: |t| {
-            (
-                t.phantoms.iter().map(|&n| f64::from(n)).sum(),
-                f64::from(t.frames),
-            )
-        },
+        parts: |t| (sum(&t.phantoms), f64::from(t.frames)),
         lower_is_better: true,
     },
     Figure {
@@ -220,51 +215,46 @@ pub fn compare(
         for fig in &FIGURES {
             let pb: Vec<(f64, f64)> = b.runs.iter().map(|(_, t)| (fig.parts)(t)).collect();
             let base_value = figure_at(&pb, &all);
-            let row = match other {
-                None => Row {
-                    family: b.family.clone(),
-                    figure: fig.name,
-                    runs: n,
-                    base: base_value,
-                    with: f64::NAN,
-                    interval: percentiles(draws.iter().map(|d| figure_at(&pb, d)).collect()),
-                    verdict: Verdict::Same,
-                },
+            let (with_value, interval, verdict) = match other {
+                None => (
+                    f64::NAN,
+                    percentiles(draws.iter().map(|d| figure_at(&pb, d)).collect()),
+                    Verdict::Same,
+                ),
                 Some(w) => {
                     let pw: Vec<(f64, f64)> = w.runs.iter().map(|(_, t)| (fig.parts)(t)).collect();
-                    let interval = percentiles(
+                    let (lo, hi) = percentiles(
                         draws
                             .iter()
                             .map(|d| figure_at(&pw, d) - figure_at(&pb, d))
                             .collect(),
                     );
+                    // Which side of 0 is the good one depends on the figure.
+                    let (good, bad) = if fig.lower_is_better {
+                        (hi < 0.0, lo > 0.0)
+                    } else {
+                        (lo > 0.0, hi < 0.0)
+                    };
                     let verdict = if pb == pw {
                         Verdict::Same
-                    } else if interval.0 > 0.0 {
-                        if fig.lower_is_better {
-                            Verdict::Worse
-                        } else {
-                            Verdict::Better
-                        }
-                    } else if interval.1 < 0.0 {
-                        if fig.lower_is_better {
-                            Verdict::Better
-                        } else {
-                            Verdict::Worse
-                        }
+                    } else if good {
+                        Verdict::Better
+                    } else if bad {
+                        Verdict::Worse
                     } else {
                         Verdict::WithinNoise
                     };
-                    Row {
-                        family: b.family.clone(),
-                        figure: fig.name,
-                        runs: n,
-                        base: base_value,
-                        with: figure_at(&pw, &all),
-                        interval,
-                        verdict,
-                    }
+                    (figure_at(&pw, &all), (lo, hi), verdict)
                 }
+            };
+            let row = Row {
+                family: b.family.clone(),
+                figure: fig.name,
+                runs: n,
+                base: base_value,
+                with: with_value,
+                interval,
+                verdict,
             };
             rows.push(row);
         }
