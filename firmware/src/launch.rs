@@ -515,15 +515,15 @@ fn load_method_b(
         threads: cfg.method_b.threads,
     };
     let path = common.model.as_deref().or(cfg.method_b.model.as_deref());
-    let model = YoloModel::load_or_builtin(path, opts).map_err(|e| (EXIT_USAGE, e.to_string()))?;
     let board = crate::power::Board::this(
         cfg.power.board,
         crate::power::device_tree_model().as_deref(),
-    );
-    let schedule = cfg
-        .method_b
-        .schedule
-        .resolve(board.unwrap_or(crate::power::Board::Pi5), live);
+    )
+    .unwrap_or(crate::power::Board::Pi5);
+    let int8 = cfg.method_b.precision == runner::Precision::Int8;
+    let model =
+        YoloModel::load_or_builtin_as(path, int8, opts).map_err(|e| (EXIT_USAGE, e.to_string()))?;
+    let schedule = cfg.method_b.schedule.resolve(board, live);
     log::info!(
         "Method B: {}, {}",
         model.name(),

@@ -313,6 +313,43 @@ fn bad_model_files_are_start_up_errors_naming_the_file() {
 }
 
 #[test]
+fn precision_picks_the_compiled_in_file_unless_a_file_is_given() {
+    let cfg = tmp("precision.toml");
+    let chosen = |toml: &str, more: &[&str]| -> String {
+        std::fs::write(&cfg, toml).unwrap();
+        let mut args = vec!["run", "--frames", "1", "--quiet", "--config"];
+        args.push(cfg.to_str().unwrap());
+        args.extend_from_slice(more);
+        let out = Command::new(env!("CARGO_BIN_EXE_umbra"))
+            .args(&args)
+            .env("RUST_LOG", "info")
+            .output()
+            .expect("run umbra");
+        assert_eq!(out.status.code(), Some(0), "{toml}");
+        let err = String::from_utf8_lossy(&out.stderr).into_owned();
+        let line = err.lines().find(|l| l.contains("Method B: ")).unwrap_or("");
+        line.to_string()
+    };
+    let int8 = "<built-in umbra-yolov8n-int8.onnx>";
+    let fp32 = "<built-in umbra-yolov8n.onnx>";
+    assert!(chosen("[method_b]\nprecision = \"int8\"\n", &[]).contains(int8));
+    assert!(chosen("[method_b]\nprecision = \"fp32\"\n", &[]).contains(fp32));
+    // fp32 by default, whatever the board.
+    assert!(chosen("[power]\nboard = \"pi3b\"\n", &[]).contains(fp32));
+    assert!(chosen("[power]\nboard = \"pi5\"\n", &[]).contains(fp32));
+    // A file is run whatever the precision says.
+    let file = Path::new(env!("CARGO_MANIFEST_DIR")).join("../models/yolo/umbra-yolov8n.onnx");
+    let f = file.to_str().unwrap();
+    let line = chosen("[method_b]\nprecision = \"int8\"\n", &["--model", f]);
+    assert!(line.contains(f) && !line.contains("built-in"), "{line}");
+    // A precision it does not know is a start-up error naming the value.
+    std::fs::write(&cfg, "[method_b]\nprecision = \"half\"\n").unwrap();
+    let out = umbra(&["run", "--frames", "1", "--config", cfg.to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("half"));
+}
+
+#[test]
 fn count_policy_keeps_and_counts_bad_packets() {
     let cap = tmp("count.bin");
     capture(

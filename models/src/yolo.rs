@@ -35,6 +35,8 @@ pub const BUILTIN_SHA256: &str = env!("UMBRA_MODEL_SHA256");
 pub const BUILTIN_INT8_SHA256: &str = env!("UMBRA_MODEL_INT8_SHA256");
 /// Name the compiled-in model goes by in messages.
 pub const BUILTIN_NAME: &str = "<built-in umbra-yolov8n.onnx>";
+/// Name the compiled-in int8 model goes by in messages.
+pub const BUILTIN_INT8_NAME: &str = "<built-in umbra-yolov8n-int8.onnx>";
 
 /// The input shape every model must accept.
 pub const INPUT_SHAPE: [usize; 4] = [1, RASTER_C, RASTER_H, RASTER_W];
@@ -164,10 +166,25 @@ impl YoloModel {
         Self::from_bytes(BUILTIN_ONNX, BUILTIN_NAME, opts)
     }
 
+    /// The compiled-in int8 model ([`BUILTIN_INT8_ONNX`]).
+    pub fn builtin_int8(opts: YoloOptions) -> Result<Self, ModelError> {
+        Self::from_bytes(BUILTIN_INT8_ONNX, BUILTIN_INT8_NAME, opts)
+    }
+
     /// Loads `path`, or the compiled-in model when there is none.
     pub fn load_or_builtin(path: Option<&Path>, opts: YoloOptions) -> Result<Self, ModelError> {
+        Self::load_or_builtin_as(path, false, opts)
+    }
+
+    /// Loads `path`, or when there is none the compiled-in model, its int8 form when `int8`.
+    pub fn load_or_builtin_as(
+        path: Option<&Path>,
+        int8: bool,
+        opts: YoloOptions,
+    ) -> Result<Self, ModelError> {
         match path {
             Some(p) => Self::load(p, opts),
+            None if int8 => Self::builtin_int8(opts),
             None => Self::builtin(opts),
         }
     }
@@ -354,8 +371,15 @@ mod test {
 
     #[test]
     fn quantised_model_loads() {
-        let mut m =
-            YoloModel::from_bytes(BUILTIN_INT8_ONNX, "int8", YoloOptions::default()).unwrap();
+        let mut m = YoloModel::load_or_builtin_as(None, true, YoloOptions::default()).unwrap();
+        assert_eq!(m.name(), BUILTIN_INT8_NAME);
+        assert_eq!(
+            m.conventions(),
+            YoloModel::builtin(YoloOptions::default())
+                .unwrap()
+                .conventions(),
+            "both compiled-in files declare how their images were drawn alike"
+        );
         assert_eq!(m.head(), Head::Logits);
         m.run(|o| assert_eq!(o.len(), perception::yolo::LOGITS_LEN))
             .unwrap();

@@ -67,6 +67,8 @@
 //! [method_b]                   # the learned pipeline (docs/method-b.md)
 //! enabled = true
 //! model = "/opt/umbra/other.onnx"  # absent: the compiled-in model (`--model` overrides)
+//! precision = "fp32"          # which compiled-in model: "fp32" or "int8" (7 % fewer instructions
+//!                              # on a Pi 3 with a 64-bit OS, slower elsewhere; docs/pi-budget.md)
 //! conf = 0.25                  # class score a detection needs
 //! iou = 0.7                    # suppression overlap
 //! agnostic_nms = true          # one report per object whatever the classes
@@ -297,6 +299,8 @@ pub struct MethodBSettings {
     pub enabled: bool,
     /// An ONNX file instead of the compiled-in model.
     pub model: Option<PathBuf>,
+    /// Which compiled-in model when there is no file: fp32 or int8.
+    pub precision: crate::runner::Precision,
     /// Score threshold.
     pub conf: f32,
     /// Suppression IoU.
@@ -328,6 +332,7 @@ impl Default for MethodBSettings {
         MethodBSettings {
             enabled: true,
             model: None,
+            precision: crate::runner::Precision::Fp32,
             conf: d.conf,
             iou: d.iou,
             agnostic_nms: d.agnostic,

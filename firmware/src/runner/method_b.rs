@@ -74,6 +74,22 @@ impl Schedule {
     }
 }
 
+/// Which compiled-in file Method B runs (`[method_b] precision`); a `--model` or `[method_b]
+/// model` file is run whatever this says. fp32 by default on every board: int8 counts fewer
+/// instructions only on a Pi 3 with a 64-bit OS (147 against 159 M a frame; a Pi 5 +4 %, a
+/// Pi 3 on a 32-bit OS +52 %, `docs/pi-budget.md`), and through the world model it finds less
+/// (`docs/world.md`, 49th session).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Precision {
+    /// `umbra-yolov8n.onnx`.
+    #[default]
+    Fp32,
+    /// `umbra-yolov8n-int8.onnx`: the same network fine-tuned through the int8 file's rounding
+    /// (`training/qat.py`), within 0.01 mAP50-95 of fp32 (`models/README.md`).
+    Int8,
+}
+
 /// Where the raster starts (`[method_b] seam`, `perception::seam`): it must be the rule the
 /// model's training images were drawn with.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Deserialize)]

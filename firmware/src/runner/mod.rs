@@ -35,7 +35,9 @@ use perception::tracks::TrackConfig;
 
 pub use b_worker::B_WORKER_JOB_BYTES;
 pub use history::{METHOD_B_HISTORY, ScanHistory};
-pub use method_b::{MethodBScratch, MethodBSetup, Network, Schedule, Seam, drawing, follow_model};
+pub use method_b::{
+    MethodBScratch, MethodBSetup, Network, Precision, Schedule, Seam, drawing, follow_model,
+};
 pub use summary::Summary;
 pub use track_log::TrackLog;
 
