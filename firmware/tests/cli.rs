@@ -10,9 +10,14 @@ use sim::lds01::{Lds01Sim, Lds01SimConfig};
 use sim::world::World;
 
 fn umbra(args: &[&str]) -> Output {
+    umbra_logging(args, "warn")
+}
+
+/// `umbra` with its log at `level` (`RUST_LOG`).
+fn umbra_logging(args: &[&str], level: &str) -> Output {
     Command::new(env!("CARGO_BIN_EXE_umbra"))
         .args(args)
-        .env("RUST_LOG", "warn")
+        .env("RUST_LOG", level)
         .output()
         .expect("run umbra")
 }
@@ -320,11 +325,7 @@ fn precision_picks_the_compiled_in_file_unless_a_file_is_given() {
         let mut args = vec!["run", "--frames", "1", "--quiet", "--config"];
         args.push(cfg.to_str().unwrap());
         args.extend_from_slice(more);
-        let out = Command::new(env!("CARGO_BIN_EXE_umbra"))
-            .args(&args)
-            .env("RUST_LOG", "info")
-            .output()
-            .expect("run umbra");
+        let out = umbra_logging(&args, "info");
         assert_eq!(out.status.code(), Some(0), "{toml}");
         let err = String::from_utf8_lossy(&out.stderr).into_owned();
         let line = err.lines().find(|l| l.contains("Method B: ")).unwrap_or("");
