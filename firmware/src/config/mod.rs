@@ -657,6 +657,11 @@ mod test {
             1,
             "a miss needs a return"
         );
+        assert_eq!(Config::default().world.tracks(true).empty_revs, 1);
+        let w: Config = toml::from_str("[world]\nempty_revs = 2\n").unwrap();
+        assert_eq!(w.world.tracks(true).empty_revs, 2);
+        let w: Config = toml::from_str("[world]\nempty_revs = 0\n").unwrap();
+        assert_eq!(w.world.tracks(true).empty_revs, 1, "an empty place counts");
         let w: Config = toml::from_str("[world]\nsingle_method_hits = 0\n").unwrap();
         assert_eq!(
             w.world.tracks(true).single_method_hits,

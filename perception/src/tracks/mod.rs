@@ -123,6 +123,9 @@ pub struct TrackConfig {
     /// (and as a view): fewer, and no method could have found it there (a far piece the
     /// LiDAR barely reaches, a dark one that mostly drops out), so its silence says nothing.
     pub miss_min_returns: u32,
+    /// Views in a row a piece's place must be seen empty before each costs `free_loss`
+    /// (`negative.rs`). 1: every one.
+    pub empty_revs: u8,
     /// Hits a track seen by one method only needs before it is reported (both methods: just
     /// [`TrackConfig::confirm_hits`]): one method's repeated mistake is the commonest phantom.
     pub single_method_hits: u32,
@@ -180,6 +183,7 @@ impl Default for TrackConfig {
             free_loss: 1.5,
             miss_loss: 0.7,
             miss_min_returns: 1,
+            empty_revs: 1,
             single_method_hits: 8,
             single_method_rate: 0.6,
             existence_cap: 6.0,
@@ -241,6 +245,10 @@ pub struct Track {
     /// Revolutions in a row it was detected while its footprint was seen empty
     /// ([`TrackConfig::seen_through_revs`]).
     pub seen_through: u8,
+    /// Returns its footprint gave when detected, a running mean ([`TrackConfig::empty_revs`]).
+    pub hit_returns: f32,
+    /// Views in a row its place was seen empty, up to now ([`TrackConfig::empty_revs`]).
+    pub empty_streak: u8,
     /// A door frame the map's walls have shown as a doorway (a gap seen through): an opening
     /// in a wall, which rays passing through do not speak against.
     pub anchored: bool,
@@ -425,17 +433,16 @@ impl Tracks {
                 cfg,
             );
         }
-        // Negative evidence for the unmatched tracks in view.
+        // What the rays say of each track (`negative.rs`). Rays with no return show a place
+        // empty only in a revolution that returned elsewhere, not a blinded LiDAR's.
         if pose_ok {
-            // Rays with no return show a place empty only in a revolution that returned
-            // elsewhere: one that returned (almost) nothing is a blinded or faulty LiDAR.
             let returned = ranges.iter().filter(|r| **r > 0.0 && r.is_finite()).count();
             let trust_none = returned >= negative::MIN_RETURNS;
             for (i, t) in self.tracks.iter_mut().enumerate() {
-                if !matched[i] {
+                if matched[i] {
+                    negative::observed(t, lidar, ranges, trust_none, cfg);
+                } else {
                     negative::unobserved(t, lidar, ranges, looked, trust_none, cfg);
-                } else if trust_none && t.born_on_free && cfg.seen_through_revs > 0 {
-                    negative::seen_through(t, lidar, ranges, cfg);
                 }
             }
         }
@@ -480,6 +487,8 @@ impl Tracks {
                 motion: Motion::new(o.centre, stamp_s),
                 born_on_free: o.class != ObjectClass::DoorFrame && self.floor.seen_free(o.centre),
                 seen_through: 0,
+                hit_returns: 0.0,
+                empty_streak: 0,
                 anchored: false,
                 box_wide_views: 0,
                 narrow_views: 0,
@@ -542,6 +551,7 @@ impl Tracks {
         t.hits = t.hits.saturating_add(1);
         t.views = t.views.saturating_add(1);
         t.last_seen = frame;
+        t.empty_streak = 0;
         if o.width_m > 0.0 && o.width_m.is_finite() {
             t.width_m = if t.width_m > 0.0 {
                 0.8 * t.width_m + 0.2 * o.width_m
@@ -1236,6 +1246,69 @@ mod test {
             (seen - after - cfg.miss_loss).abs() < 1e-6,
             "{seen} → {after}"
         );
+    }
+
+    /// `chair_on_two_legs`'s revolution with its legs' returns dropped out: the rays across
+    /// its footprint return nothing, the room's walls elsewhere still return.
+    fn legs_dropped_out(mut scan: [f32; BINS]) -> [f32; BINS] {
+        scan[350..BINS].fill(0.0);
+        scan[..=10].fill(0.0);
+        scan
+    }
+
+    #[test]
+    fn a_dark_piece_seen_empty_only_by_rays_with_no_return_counts_in_a_row() {
+        let cfg = TrackConfig {
+            empty_revs: 2,
+            ..quick()
+        };
+        let (mut t, scan) = chair_on_two_legs(&cfg);
+        let dark = legs_dropped_out(scan);
+        let seen = t.all()[0].existence;
+        // One revolution in which the legs' returns dropped out says nothing yet...
+        step(&mut t, 4, &[], &Pose2::IDENTITY, &dark, &cfg);
+        assert_eq!(t.all()[0].existence, seen);
+        // ...nor does it after a detection broke the row...
+        let chair = [obs(CHAIR, 2.0, 0.0, 0.9, Evidence::A)];
+        step(&mut t, 5, &chair, &Pose2::IDENTITY, &scan, &cfg);
+        let seen = t.all()[0].existence;
+        step(&mut t, 6, &[], &Pose2::IDENTITY, &dark, &cfg);
+        assert_eq!(t.all()[0].existence, seen);
+        // ...the second in a row does, and each one after it.
+        step(&mut t, 7, &[], &Pose2::IDENTITY, &dark, &cfg);
+        assert!((seen - t.all()[0].existence - cfg.free_loss).abs() < 1e-6);
+        step(&mut t, 8, &[], &Pose2::IDENTITY, &dark, &cfg);
+        assert!((seen - t.all()[0].existence - 2.0 * cfg.free_loss).abs() < 1e-6);
+        // Rays that return from beyond the whole footprint show it empty at once.
+        let (mut t, _) = chair_on_two_legs(&cfg);
+        let seen = t.all()[0].existence;
+        step(&mut t, 4, &[], &Pose2::IDENTITY, &ranges(3.4), &cfg);
+        assert!((seen - t.all()[0].existence - cfg.free_loss).abs() < 1e-6);
+        // Nor does a row matter where the footprint returned nothing when it was detected (a
+        // phantom in the open, not a dark piece).
+        let mut t = Tracks::new();
+        let open = legs_dropped_out(ranges(3.4));
+        for f in 0..4 {
+            let chair = [obs(CHAIR, 2.0, 0.0, 0.9, Evidence::A)];
+            step(&mut t, f, &chair, &Pose2::IDENTITY, &open, &cfg);
+        }
+        assert_eq!(t.all()[0].hit_returns, 0.0);
+        let seen = t.all()[0].existence;
+        step(&mut t, 4, &[], &Pose2::IDENTITY, &open, &cfg);
+        assert!((seen - t.all()[0].existence - cfg.free_loss).abs() < 1e-6);
+        // With `empty_revs` 1 (the default) the first dark revolution counts.
+        let one = quick();
+        let (mut t, scan) = chair_on_two_legs(&one);
+        let seen = t.all()[0].existence;
+        step(
+            &mut t,
+            4,
+            &[],
+            &Pose2::IDENTITY,
+            &legs_dropped_out(scan),
+            &one,
+        );
+        assert!((seen - t.all()[0].existence - one.free_loss).abs() < 1e-6);
     }
 
     #[test]

@@ -13,6 +13,13 @@
 //!   [`TrackConfig::miss_min_returns`] (too few for a method to find it by), unless it was
 //!   born on floor seen empty.
 //!
+//! One setting, off by default, weighs the evidence by what the track's own footprint returned
+//! when it was detected ([`Track::hit_returns`]): with [`TrackConfig::empty_revs`] above 1, a
+//! place seen empty only through rays with no return, where the piece had returned rays, counts
+//! once it has been so in that many views in a row (a dark chair's two or three leg returns at
+//! 2–2.5 m drop out together now and then, and the rest of its footprint is floor between the
+//! legs). Held out it raised the annex's phantoms (`docs/world.md`, 50th session).
+//!
 //! And one for a track it did observe: furniture born on floor seen empty whose footprint the
 //! rays pass while its detections go on beside it ([`seen_through`]): legs that stood there a
 //! moment and walked on.
@@ -99,8 +106,36 @@ pub(super) fn unobserved(
             View::Plain(n) if looked_for && (n >= cfg.miss_min_returns || t.born_on_free) => {
                 (Said::Missed, true)
             }
-            View::Plain(_) | View::Hidden => (Said::Nothing, false),
+            View::Plain(_) => {
+                t.empty_streak = 0;
+                (Said::Nothing, false)
+            }
+            View::Hidden => (Said::Nothing, false),
         }
+    };
+    // A place seen empty counts once it has been so in enough views in a row (revolutions
+    // that hid it do not break the row; rays ending in it, or a detection, do).
+    let said = match said {
+        Said::Empty => {
+            t.empty_streak = t.empty_streak.saturating_add(1);
+            // Rays that returned from beyond it show it empty at once, as do rays that
+            // returned nothing across a place that returned nothing when it was detected; across
+            // one that did, they count only in a row (a dark piece's few returns at range drop
+            // out together now and then).
+            if t.empty_streak >= cfg.empty_revs
+                || t.hit_returns <= 0.0
+                || view(t.centre, t.radius(), lidar, ranges, cfg.max_range_m) == View::Empty
+            {
+                Said::Empty
+            } else {
+                Said::Nothing
+            }
+        }
+        Said::Missed => {
+            t.empty_streak = 0;
+            said
+        }
+        Said::Nothing => said,
     };
     let loss = match said {
         Said::Missed => cfg.miss_loss,
@@ -125,9 +160,39 @@ fn lose(t: &mut Track, loss: f32, cfg: &TrackConfig) {
     }
 }
 
+/// What this revolution says of `t`, which took an observation: the returns its footprint
+/// gave ([`Track::hit_returns`], only where [`TrackConfig::empty_revs`] reads them), and
+/// whether it is seen through ([`seen_through`]).
+pub(super) fn observed(
+    t: &mut Track,
+    lidar: &Pose2,
+    ranges: &[f32; BINS],
+    trust_none: bool,
+    cfg: &TrackConfig,
+) {
+    if cfg.empty_revs > 1 {
+        note_hit_returns(t, lidar, ranges, cfg);
+    }
+    if trust_none && t.born_on_free && cfg.seen_through_revs > 0 {
+        seen_through(t, lidar, ranges, cfg);
+    }
+}
+
+/// Notes the returns `t`'s footprint gave in this revolution, in which it was detected.
+fn note_hit_returns(t: &mut Track, lidar: &Pose2, ranges: &[f32; BINS], cfg: &TrackConfig) {
+    if let View::Plain(n) = view(t.centre, t.radius(), lidar, ranges, cfg.max_range_m) {
+        let n = n as f32;
+        t.hit_returns = if t.hit_returns > 0.0 {
+            0.8 * t.hit_returns + 0.2 * n
+        } else {
+            n
+        };
+    }
+}
+
 /// A track born on free floor and detected this frame: if its footprint is seen empty in
 /// [`TrackConfig::seen_through_revs`] revolutions in a row, it loses `free_loss` as if unseen.
-pub(super) fn seen_through(t: &mut Track, lidar: &Pose2, ranges: &[f32; BINS], cfg: &TrackConfig) {
+fn seen_through(t: &mut Track, lidar: &Pose2, ranges: &[f32; BINS], cfg: &TrackConfig) {
     if footprint_view(t.centre, t.radius(), lidar, ranges, cfg.max_range_m) != View::Empty {
         t.seen_through = 0;
         return;
