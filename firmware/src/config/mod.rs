@@ -662,6 +662,9 @@ mod test {
         assert_eq!(w.world.tracks(true).empty_revs, 2);
         let w: Config = toml::from_str("[world]\nempty_revs = 0\n").unwrap();
         assert_eq!(w.world.tracks(true).empty_revs, 1, "an empty place counts");
+        assert_eq!(Config::default().world.tracks(true).cross_merge_m, 0.0);
+        let w: Config = toml::from_str("[world]\ncross_merge_m = 0.25\n").unwrap();
+        assert_eq!(w.world.tracks(true).cross_merge_m, 0.25);
         let w: Config = toml::from_str("[world]\nsingle_method_hits = 0\n").unwrap();
         assert_eq!(
             w.world.tracks(true).single_method_hits,

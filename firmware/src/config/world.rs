@@ -74,6 +74,9 @@ pub struct WorldSettings {
     /// phantoms held out, +0.007 and +0.019 a frame on two sets of seeds (docs/world.md, 50th
     /// session).
     pub empty_revs: u8,
+    /// Furniture tracks of different classes closer than this are one piece, m
+    /// (`perception::tracks::TrackConfig::cross_merge_m`). 0: never.
+    pub cross_merge_m: f32,
 }
 
 /// `min_likelihood` while Method B runs, unless set: held out it cut phantoms in every family
@@ -99,6 +102,7 @@ impl Default for WorldSettings {
             single_method_hits: perception::tracks::TrackConfig::default().single_method_hits,
             seen_through_revs: 2,
             empty_revs: 1,
+            cross_merge_m: 0.0,
         }
     }
 }
@@ -143,6 +147,9 @@ impl WorldSettings {
         c.single_method_hits = self.single_method_hits.max(1);
         c.seen_through_revs = self.seen_through_revs;
         c.empty_revs = self.empty_revs.max(1);
+        if self.cross_merge_m.is_finite() {
+            c.cross_merge_m = self.cross_merge_m.clamp(0.0, 1.0);
+        }
         c
     }
 }

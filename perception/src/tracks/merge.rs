@@ -1,5 +1,6 @@
-//! One object seen twice: tracks of one class closer than the class's merge radius become one
-//! track, which keeps the reported id and takes the other's evidence.
+//! One object seen twice: tracks of one class closer than the class's merge radius (and, where
+//! set, furniture tracks of different classes closer than `cross_merge_m`) become one track,
+//! which keeps the reported id and takes the other's evidence.
 
 use crate::class::ObjectClass;
 use crate::geometry::Point2;
@@ -20,16 +21,24 @@ fn merge_radius(c: ObjectClass) -> f32 {
 impl Tracks {
     /// Tracks of one class within its [`merge_radius`] are one object: the confirmed one (then
     /// the one with more hits, then the older) keeps its id and takes the other's evidence.
-    pub(super) fn merge_duplicates(&mut self) {
+    /// Furniture tracks of different classes closer than `cross_m` are one piece too
+    /// ([`super::TrackConfig::cross_merge_m`]; 0: never): its class is then the one the summed
+    /// evidence favours.
+    pub(super) fn merge_duplicates(&mut self, cross_m: f32) {
         let mut i = 0;
         while i < self.tracks.len() {
             let mut j = i + 1;
             while j < self.tracks.len() {
                 let (a, b) = (&self.tracks[i], &self.tracks[j]);
+                let d = a.centre.distance(b.centre);
+                let furniture = |t: &Track| t.class() != ObjectClass::DoorFrame;
                 let same = !a.motion.moving
                     && !b.motion.moving
-                    && a.class() == b.class()
-                    && a.centre.distance(b.centre) < merge_radius(a.class());
+                    && if a.class() == b.class() {
+                        d < merge_radius(a.class())
+                    } else {
+                        furniture(a) && furniture(b) && d < cross_m
+                    };
                 if !same {
                     j += 1;
                     continue;

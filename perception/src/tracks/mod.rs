@@ -126,6 +126,8 @@ pub struct TrackConfig {
     /// Views in a row a piece's place must be seen empty before each costs `free_loss`
     /// (`negative.rs`). 1: every one.
     pub empty_revs: u8,
+    /// Furniture tracks of different classes closer than this are one piece, m (`merge.rs`).
+    pub cross_merge_m: f32,
     /// Hits a track seen by one method only needs before it is reported (both methods: just
     /// [`TrackConfig::confirm_hits`]): one method's repeated mistake is the commonest phantom.
     pub single_method_hits: u32,
@@ -184,6 +186,7 @@ impl Default for TrackConfig {
             miss_loss: 0.7,
             miss_min_returns: 1,
             empty_revs: 1,
+            cross_merge_m: 0.0,
             single_method_hits: 8,
             single_method_rate: 0.6,
             existence_cap: 6.0,
@@ -446,7 +449,7 @@ impl Tracks {
                 }
             }
         }
-        self.merge_duplicates();
+        self.merge_duplicates(cfg.cross_merge_m);
         // Deletion.
         let mut i = 0;
         while i < self.tracks.len() {
@@ -1309,6 +1312,34 @@ mod test {
             &one,
         );
         assert!((seen - t.all()[0].existence - one.free_loss).abs() < 1e-6);
+    }
+
+    #[test]
+    fn furniture_of_two_classes_on_one_spot_is_one_piece_where_set() {
+        // One piece taken for a chair and for a box, 0.2 m apart, two frames running.
+        let seen = |cross_merge_m: f32| {
+            let cfg = TrackConfig {
+                cross_merge_m,
+                ..quick()
+            };
+            let mut t = Tracks::new();
+            let scan = ranges(0.0);
+            let both = [
+                obs(CHAIR, 2.0, 0.0, 0.9, Evidence::B),
+                obs(ObjectClass::Box, 2.2, 0.0, 0.6, Evidence::B),
+            ];
+            for f in 0..2 {
+                step(&mut t, f, &both, &Pose2::IDENTITY, &scan, &cfg);
+            }
+            t
+        };
+        assert_eq!(seen(0.0).all().len(), 2, "off: two tracks");
+        let one = seen(0.3);
+        assert_eq!(one.all().len(), 1);
+        assert_eq!(one.all()[0].class(), CHAIR, "the class with more evidence");
+        assert_eq!(one.stats().merged, 1);
+        // Farther apart than that: two pieces.
+        assert_eq!(seen(0.15).all().len(), 2);
     }
 
     #[test]
