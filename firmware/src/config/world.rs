@@ -75,7 +75,9 @@ pub struct WorldSettings {
     /// session).
     pub empty_revs: u8,
     /// Furniture tracks of different classes closer than this are one piece, m
-    /// (`perception::tracks::TrackConfig::cross_merge_m`). 0: never.
+    /// (`perception::tracks::TrackConfig::cross_merge_m`). 0 (never) by default: 0.25 raised the
+    /// annex's IDF1 held out (0.656 → 0.679) and its phantoms (0.387 → 0.396 a frame;
+    /// docs/world.md, 50th session).
     pub cross_merge_m: f32,
 }
 
