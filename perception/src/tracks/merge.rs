@@ -5,7 +5,8 @@
 use crate::class::ObjectClass;
 use crate::geometry::Point2;
 
-use super::{Track, Tracks};
+use super::association::class_cost;
+use super::{Track, TrackConfig, Tracks};
 
 /// Two tracks of one class closer than this are one object seen twice, m: less than the
 /// closest two distinct pieces of the class stand (chairs side by side ~0.45 m, desks back
@@ -21,23 +22,22 @@ fn merge_radius(c: ObjectClass) -> f32 {
 impl Tracks {
     /// Tracks of one class within its [`merge_radius`] are one object: the confirmed one (then
     /// the one with more hits, then the older) keeps its id and takes the other's evidence.
-    /// Furniture tracks of different classes closer than `cross_m` are one piece too
-    /// ([`super::TrackConfig::cross_merge_m`]; 0: never): its class is then the one the summed
-    /// evidence favours.
-    pub(super) fn merge_duplicates(&mut self, cross_m: f32) {
+    /// Tracks of different classes that may be one object (the association's rule,
+    /// [`class_cost`]: furniture with furniture) closer than [`TrackConfig::cross_merge_m`]
+    /// (0: never) are one piece too: its class is then the one the summed evidence favours.
+    pub(super) fn merge_duplicates(&mut self, cfg: &TrackConfig) {
         let mut i = 0;
         while i < self.tracks.len() {
             let mut j = i + 1;
             while j < self.tracks.len() {
                 let (a, b) = (&self.tracks[i], &self.tracks[j]);
                 let d = a.centre.distance(b.centre);
-                let furniture = |t: &Track| t.class() != ObjectClass::DoorFrame;
                 let same = !a.motion.moving
                     && !b.motion.moving
                     && if a.class() == b.class() {
                         d < merge_radius(a.class())
                     } else {
-                        furniture(a) && furniture(b) && d < cross_m
+                        d < cfg.cross_merge_m && class_cost(a.class(), b.class(), cfg).is_some()
                     };
                 if !same {
                     j += 1;

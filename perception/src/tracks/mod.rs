@@ -449,7 +449,7 @@ impl Tracks {
                 }
             }
         }
-        self.merge_duplicates(cfg.cross_merge_m);
+        self.merge_duplicates(cfg);
         // Deletion.
         let mut i = 0;
         while i < self.tracks.len() {
