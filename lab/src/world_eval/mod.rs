@@ -9,6 +9,7 @@
 
 mod assignment;
 pub mod compare;
+pub mod confusion;
 mod describe;
 pub mod fates;
 mod line;
@@ -375,6 +376,7 @@ pub fn report(outcomes: &[Outcome]) -> String {
                 ph(&t.det_phantoms, f64::from(t.det_frames))
             );
             reliability_lines(&mut s, &t.reliability);
+            confusion::lines(&mut s, &t.confusion);
         }
         let _ = writeln!(
             s,

@@ -10,7 +10,7 @@ pub use super::assignment::max_assignment;
 pub use super::line::{Line, Reported};
 pub use super::places::{BESIDE_M, CLUTTER_M, DOORWAY_M, PHANTOM_PLACES, WALL_FACE_M};
 use super::places::{at_wall_face, phantom_place};
-use super::reliability;
+use super::{confusion, reliability};
 use super::unrefuted::unrefuted;
 use crate::eval_a::class_index;
 use crate::run_truth::{Furniture, PERSON_VISIBLE_RETURNS, Person, RunTruth};
@@ -134,6 +134,10 @@ pub struct Tally {
     /// Pieces the final map is scored on by class (chair, box, desk) and `fates::FATES`.
     #[serde(default)]
     pub fates: [[u32; super::fates::FATE_COUNT]; 3],
+    /// The detections on a piece by source, the piece's class and the class they gave it
+    /// ([`super::confusion`]).
+    #[serde(default)]
+    pub confusion: super::confusion::Confusion,
     /// The reports on walking people, one line each (frame, id, class, source), for reading.
     #[serde(skip)]
     pub people_reports: Vec<String>,
@@ -195,6 +199,7 @@ pub fn score_run(truth: &RunTruth, lines: &[Line], tally: &mut Tally) {
                         on_furniture(&alive, o.at).any(|f| f.class == c)
                     };
                     reliability::count(&mut tally.reliability, o.source, c, o.score, right);
+                    confusion::count(&mut tally.confusion, &alive, o.source, c, o.at, MATCH_M);
                 }
                 match o.class {
                     Some(ObjectClass::DoorFrame) => {
@@ -541,6 +546,7 @@ impl Tally {
             *a += b;
         }
         super::fates::add(&mut self.fates, &o.fates);
+        confusion::add(&mut self.confusion, &o.confusion);
     }
 
     /// IDF1 = 2·IDTP / (GT + reported).
