@@ -43,7 +43,12 @@ pub fn count(
 
 /// Adds `o` into `c`.
 pub fn add(c: &mut Confusion, o: &Confusion) {
-    for (a, b) in c.iter_mut().flatten().flatten().zip(o.iter().flatten().flatten()) {
+    for (a, b) in c
+        .iter_mut()
+        .flatten()
+        .flatten()
+        .zip(o.iter().flatten().flatten())
+    {
         *a += b;
     }
 }
@@ -104,15 +109,21 @@ mod tests {
 
     #[test]
     fn a_detection_counts_on_the_nearest_piece_within_reach_only() {
-        let (chair, desk) = (piece(ObjectClass::Chair, 0.0), piece(ObjectClass::Desk, 0.6));
+        let (chair, desk) = (
+            piece(ObjectClass::Chair, 0.0),
+            piece(ObjectClass::Desk, 0.6),
+        );
         let alive = [&chair, &desk];
         let mut c = Confusion::default();
+        let mut at = |source, class, x, y| {
+            count(&mut c, &alive, source, class, Point2::new(x, y), 0.3);
+        };
         // Nearer the chair's footprint (0.05 m) than the desk's (0.15 m): the chair's.
-        count(&mut c, &alive, 1, ObjectClass::Desk, Point2::new(0.25, 0.0), 0.3);
+        at(1, ObjectClass::Desk, 0.25, 0.0);
         // On the desk.
-        count(&mut c, &alive, 0, ObjectClass::Box, Point2::new(0.6, 0.0), 0.3);
+        at(0, ObjectClass::Box, 0.6, 0.0);
         // 0.5 m from anything: not counted.
-        count(&mut c, &alive, 1, ObjectClass::Chair, Point2::new(0.0, 0.7), 0.3);
+        at(1, ObjectClass::Chair, 0.0, 0.7);
         assert_eq!(c[1][0], [0, 0, 1, 0]);
         assert_eq!(c[0][2], [0, 1, 0, 0]);
         assert_eq!(c.iter().flatten().flatten().sum::<u32>(), 2);
@@ -121,8 +132,14 @@ mod tests {
         assert_eq!(sum[1][0][2], 2);
         let mut s = String::new();
         lines(&mut s, &c);
-        assert!(s.contains("B  on a chair 0.00 / 0.00 / 1.00 / 0.00 of 1"), "{s}");
-        assert!(s.contains("A  on a desk  0.00 / 1.00 / 0.00 / 0.00 of 1"), "{s}");
+        assert!(
+            s.contains("B  on a chair 0.00 / 0.00 / 1.00 / 0.00 of 1"),
+            "{s}"
+        );
+        assert!(
+            s.contains("A  on a desk  0.00 / 1.00 / 0.00 / 0.00 of 1"),
+            "{s}"
+        );
         assert!(!s.contains("AB"), "{s}");
     }
 }

@@ -10,8 +10,8 @@ pub use super::assignment::max_assignment;
 pub use super::line::{Line, Reported};
 pub use super::places::{BESIDE_M, CLUTTER_M, DOORWAY_M, PHANTOM_PLACES, WALL_FACE_M};
 use super::places::{at_wall_face, phantom_place};
-use super::{confusion, reliability};
 use super::unrefuted::unrefuted;
+use super::{confusion, reliability};
 use crate::eval_a::class_index;
 use crate::run_truth::{Furniture, PERSON_VISIBLE_RETURNS, Person, RunTruth};
 
