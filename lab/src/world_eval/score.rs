@@ -930,6 +930,13 @@ mod test {
                 _ => {}
             }
         }
+        // Every number in nested arrays set to `x`.
+        fn fill(v: &mut serde_json::Value, x: u32) {
+            match v {
+                serde_json::Value::Array(a) => a.iter_mut().for_each(|e| fill(e, x)),
+                _ => *v = x.into(),
+            }
+        }
         let one = |k: u32| {
             let mut t = Tally::default();
             let mut j = serde_json::to_value(&t).unwrap();
@@ -941,12 +948,7 @@ mod test {
                         serde_json::Value::Array(a) if a.is_empty() => {
                             *v = vec![serde_json::Value::from(x)].into()
                         }
-                        serde_json::Value::Array(a) => a.iter_mut().for_each(|e| match e {
-                            serde_json::Value::Array(row) => {
-                                row.iter_mut().for_each(|e| *e = x.into())
-                            }
-                            _ => *e = x.into(),
-                        }),
+                        serde_json::Value::Array(_) => fill(v, x),
                         _ => {}
                     }
                 }
