@@ -3,7 +3,7 @@
 //! (`Tally::confusion`). A detector that takes one class for another shows here, where the
 //! final map only shows the piece missing or reported as another class.
 
-use core::fmt::Write as _;
+use std::fmt::Write as _;
 
 use perception::class::ObjectClass;
 use perception::geometry::Point2;
