@@ -47,6 +47,28 @@ impl Furniture {
     pub fn distance(&self, p: Point2) -> f32 {
         polygon_distance(&self.footprint, p)
     }
+
+    /// For tests: piece `piece` of `class`, a square of half-side `half` m centred at `c`,
+    /// there and visible from the first frame to the end.
+    #[cfg(test)]
+    pub fn square(piece: usize, class: ObjectClass, c: Point2, half: f32) -> Furniture {
+        Furniture {
+            piece,
+            class,
+            footprint: vec![
+                Point2::new(c.x - half, c.y - half),
+                Point2::new(c.x + half, c.y - half),
+                Point2::new(c.x + half, c.y + half),
+                Point2::new(c.x - half, c.y + half),
+            ],
+            from_frame: 0,
+            to_frame: usize::MAX,
+            visible_from: Some(0),
+            returns: 100,
+            what: String::new(),
+            against_wall: false,
+        }
+    }
 }
 
 /// A doorway.

@@ -88,23 +88,7 @@ mod tests {
     use super::*;
 
     fn piece(class: ObjectClass, x: f32) -> Furniture {
-        let fp = vec![
-            Point2::new(x - 0.2, -0.2),
-            Point2::new(x + 0.2, -0.2),
-            Point2::new(x + 0.2, 0.2),
-            Point2::new(x - 0.2, 0.2),
-        ];
-        Furniture {
-            piece: 0,
-            class,
-            footprint: fp,
-            from_frame: 0,
-            to_frame: usize::MAX,
-            visible_from: Some(0),
-            returns: 100,
-            what: String::new(),
-            against_wall: false,
-        }
+        Furniture::square(0, class, Point2::new(x, 0.0), 0.2)
     }
 
     #[test]

@@ -112,20 +112,8 @@ mod test {
 
     fn piece() -> Furniture {
         Furniture {
-            piece: 0,
-            class: ObjectClass::Chair,
-            footprint: vec![
-                Point2::new(0.0, 0.0),
-                Point2::new(0.4, 0.0),
-                Point2::new(0.4, 0.4),
-                Point2::new(0.0, 0.4),
-            ],
-            from_frame: 0,
-            to_frame: usize::MAX,
-            visible_from: Some(0),
-            returns: 100,
             what: "chair".into(),
-            against_wall: false,
+            ..Furniture::square(0, ObjectClass::Chair, Point2::new(0.2, 0.2), 0.2)
         }
     }
 

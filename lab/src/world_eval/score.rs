@@ -570,27 +570,8 @@ mod test {
     use crate::run_truth::{Door, FrameTruth, Move};
     use perception::geometry::Pose2;
 
-    fn square(c: Point2, h: f32) -> Vec<Point2> {
-        vec![
-            Point2::new(c.x - h, c.y - h),
-            Point2::new(c.x + h, c.y - h),
-            Point2::new(c.x + h, c.y + h),
-            Point2::new(c.x - h, c.y + h),
-        ]
-    }
-
     fn truth() -> RunTruth {
-        let f = |piece, class, x, y| Furniture {
-            piece,
-            class,
-            footprint: square(Point2::new(x, y), 0.2),
-            from_frame: 0,
-            to_frame: usize::MAX,
-            visible_from: Some(0),
-            returns: 100,
-            what: String::new(),
-            against_wall: false,
-        };
+        let f = |piece, class, x, y| Furniture::square(piece, class, Point2::new(x, y), 0.2);
         RunTruth {
             name: "t".into(),
             furniture: vec![
