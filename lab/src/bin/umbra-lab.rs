@@ -90,6 +90,10 @@ enum Command {
         /// --round-tables`; 0: none).
         #[arg(long, default_value_t = 0.0)]
         round_tables: f64,
+        /// Share of a varied world's boxes drawn with sides of their own (`umbra-sim dataset
+        /// --box-sizes`; 0: none).
+        #[arg(long, default_value_t = 0.0)]
+        box_sizes: f64,
         /// Share of scenes seen by a worn LiDAR (`umbra-sim dataset --worn`; 0: none).
         #[arg(long, default_value_t = 0.0)]
         worn: f64,
@@ -315,11 +319,13 @@ fn run(cli: Cli) -> Result<(), String> {
             varied,
             office_chairs,
             round_tables,
+            box_sizes,
             worn,
         } => {
             let mut cfg = scene_cfg(seed, pose, Worlds { clutter, varied });
             cfg.world.office_chairs = office_chairs;
             cfg.world.round_tables = round_tables;
+            cfg.world.box_sizes = box_sizes;
             cfg.worn = worn;
             let mut method = Box::new(MethodA::new());
             let mut text = csv_header();

@@ -78,6 +78,10 @@ enum Command {
         /// Share of a varied world's desks drawn as round tables on three or four legs (0–1).
         #[arg(long, default_value_t = 0.0)]
         round_tables: f64,
+        /// Share of a varied world's boxes drawn with sides of their own, 0.3–0.9 × 0.25–0.6 m
+        /// (0–1).
+        #[arg(long, default_value_t = 0.0)]
+        box_sizes: f64,
         /// Skip Method B images and labels.
         #[arg(long)]
         no_images: bool,
@@ -196,6 +200,7 @@ fn run(command: Command) -> Result<(), String> {
             varied,
             office_chairs,
             round_tables,
+            box_sizes,
             no_images,
             no_method_a,
             no_recordings,
@@ -216,6 +221,7 @@ fn run(command: Command) -> Result<(), String> {
                     varied,
                     office_chairs,
                     round_tables,
+                    box_sizes,
                     ..WorldConfig::default()
                 },
                 method_b: !no_images,

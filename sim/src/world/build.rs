@@ -49,8 +49,10 @@ pub(super) struct Builder {
     pub(super) office_share: f64,
     /// Share of desks that are round tables (0 unless asked for in a varied world).
     pub(super) round_share: f64,
+    /// Share of boxes drawn with sides of their own (0 unless asked for in a varied world).
+    pub(super) box_share: f64,
     /// A second stream for the furniture styles of a varied world (`variety.rs`: office
-    /// chairs, round tables), drawn from only when they are asked for.
+    /// chairs, round tables, box sizes), drawn from only when they are asked for.
     pub(super) style: ChaCha8Rng,
 }
 
@@ -309,7 +311,14 @@ impl Builder {
                     Some(((0.8 * scale, 0.4 * scale), Build::Legs(0.025 * scale)))
                 }
             }
-            ObjectClass::Box => Some(((0.3 * scale, 0.2 * scale), Build::Solid)),
+            ObjectClass::Box => {
+                if self.box_share > 0.0 && self.style.random_bool(self.box_share) {
+                    let (long, deep) = (self.style.random(), self.style.random());
+                    Some((super::variety::box_half(long, deep), Build::Solid))
+                } else {
+                    Some(((0.3 * scale, 0.2 * scale), Build::Solid))
+                }
+            }
             ObjectClass::DoorFrame => None,
         }
     }

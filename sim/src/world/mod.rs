@@ -233,6 +233,11 @@ pub struct WorldConfig {
     /// Share of a varied world's desks drawn as round tables on three or four legs
     /// (`variety.rs`). 0 (the default) draws none and leaves every world as it was.
     pub round_tables: f64,
+    /// Share of a varied world's boxes drawn with sides of their own
+    /// ([`variety::box_half`]: storage and moving boxes, crates and low cabinets, 0.3–0.9 m
+    /// long and 0.25–0.6 m deep, square ones too) instead of the study's 3 : 2 box. 0 (the
+    /// default) draws none and leaves every world as it was.
+    pub box_sizes: f64,
 }
 
 impl Default for WorldConfig {
@@ -245,6 +250,7 @@ impl Default for WorldConfig {
             varied: 0.0,
             office_chairs: 0.0,
             round_tables: 0.0,
+            box_sizes: 0.0,
         }
     }
 }
@@ -300,6 +306,11 @@ impl World {
             },
             round_share: if varied {
                 cfg.round_tables.clamp(0.0, 1.0)
+            } else {
+                0.0
+            },
+            box_share: if varied {
+                cfg.box_sizes.clamp(0.0, 1.0)
             } else {
                 0.0
             },

@@ -17,7 +17,9 @@
 //! * round tables on request ([`super::WorldConfig::round_tables`] of the desks; none by
 //!   default), 0.7–1.1 m across on three or four legs (2–5 cm) set 5–12 cm in from the top's
 //!   edge. A pedestal table would show its column alone at LiDAR height, a post like any
-//!   other (the office chair's lesson): not drawn. From the `style` stream too.
+//!   other (the office chair's lesson): not drawn. From the `style` stream too;
+//! * boxes of other sizes on request ([`super::WorldConfig::box_sizes`] of the boxes; none by
+//!   default): sides of their own, square ones too ([`box_half`]). From the `style` stream.
 //!
 //! Wall thickness (0.05–0.25 m) and reflectivity (0.12–1.0) are drawn in `build.rs`; the
 //! LiDAR's reach and dropouts in `Lds01SimConfig::varied`. Everything here draws from the
@@ -42,6 +44,18 @@ const WALL_SIDE_GAP: f32 = 0.35;
 /// m, the 0.5–0.7 m bases office chairs stand on.
 pub(super) fn star_radius(half: (f32, f32)) -> f32 {
     (half.0.max(half.1) * 1.45).clamp(0.25, 0.35)
+}
+
+/// Half-sides of a box with sides of its own, from two uniform draws `long_u`, `deep_u` in
+/// [0, 1): 0.3–0.9 m along, and across from 0.25 m up to the lesser of its length and 0.6 m.
+/// The study's boxes are one shape (0.48–0.72 × 0.32–0.48, always 3 : 2); boxes in rooms are
+/// storage and moving boxes (0.3–0.6 m, many square), crates and low cabinets up to 0.9 m
+/// long. General sizes; nobody read the evaluation annex's generator for them.
+pub(super) fn box_half(long_u: f32, deep_u: f32) -> (f32, f32) {
+    let long = 0.3 + 0.6 * long_u.clamp(0.0, 1.0);
+    let deep_max = long.min(0.6);
+    let deep = 0.25 + (deep_max - 0.25) * deep_u.clamp(0.0, 1.0);
+    (long / 2.0, deep / 2.0)
 }
 
 /// The top's radius of a round table drawn at `scale` (0.8–1.2): 0.35–0.55 m.
@@ -629,5 +643,56 @@ mod test {
             tables * 4 >= desks && tables * 4 <= desks * 3,
             "{tables} round tables of {desks} desks"
         );
+    }
+
+    #[test]
+    fn boxes_take_sides_of_their_own_in_varied_worlds_when_asked() {
+        let sized = WorldConfig {
+            box_sizes: 0.5,
+            ..varied()
+        };
+        let (mut boxes, mut own, mut squarish) = (0, 0, 0);
+        for seed in 0..80 {
+            let w = World::generate(seed, &sized);
+            for o in w.objects.iter().filter(|o| o.class == ObjectClass::Box) {
+                boxes += 1;
+                let a = o.footprint[0].distance(o.footprint[1]);
+                let b = o.footprint[1].distance(o.footprint[2]);
+                let (long, deep) = (a.max(b), a.min(b));
+                // The study's box: 0.48–0.72 × 0.32–0.48, always 3 : 2.
+                let study = (long / deep - 1.5).abs() < 1e-3 && (0.479..0.721).contains(&long);
+                if !study {
+                    assert!((0.299..0.901).contains(&long), "seed {seed}: {long} m long");
+                    assert!(
+                        (0.249..=long.min(0.6) + 1e-3).contains(&deep),
+                        "seed {seed}: {long} × {deep} m"
+                    );
+                    own += 1;
+                    squarish += usize::from(long / deep < 1.2);
+                }
+            }
+            // Asked for in a world drawn without variety: the world is the one it always was.
+            let study = WorldConfig {
+                box_sizes: 0.5,
+                ..WorldConfig::default()
+            };
+            assert_eq!(
+                World::generate(seed, &study).prims,
+                World::generate(seed, &WorldConfig::default()).prims
+            );
+        }
+        // Half the boxes, a fair share of them near square.
+        assert!(own * 4 >= boxes && own * 4 <= boxes * 3, "{own} of {boxes}");
+        assert!(squarish * 5 >= own, "{squarish} near square of {own}");
+    }
+
+    #[test]
+    fn box_half_spans_its_sizes() {
+        assert_eq!(box_half(0.0, 0.0), (0.15, 0.125));
+        let (l, d) = box_half(1.0, 1.0);
+        assert!((l - 0.45).abs() < 1e-6 && (d - 0.3).abs() < 1e-6);
+        // Never deeper than long.
+        let (l, d) = box_half(0.0, 1.0);
+        assert!((l - d).abs() < 1e-6);
     }
 }
