@@ -15,7 +15,7 @@ use perception::pose::{OdometryConfig, TickCounter, integrate};
 
 use sim::dataset::{scenario_config, scenario_seed};
 use sim::lds01::LIDAR_MOUNT;
-use sim::scenario::{Frame, OdomSample, Scenario};
+use sim::scenario::{Frame, OdomSample, Scenario, ScenarioConfig};
 use sim::world::{Surface, World, WorldConfig};
 
 /// Where the pipeline's pose comes from.
@@ -44,6 +44,9 @@ pub struct SceneConfig {
     pub pose: PoseSource,
     /// Share of scenes seen by a worn LiDAR (`ScenarioConfig::worn`; 0: none).
     pub worn: f64,
+    /// Share of scenes seen by a LiDAR that returns by received power
+    /// (`ScenarioConfig::power`; 0: none).
+    pub power: f64,
 }
 
 impl Default for SceneConfig {
@@ -56,6 +59,7 @@ impl Default for SceneConfig {
             every: 15,
             pose: PoseSource::Odometry,
             worn: 0.0,
+            power: 0.0,
         }
     }
 }
@@ -197,7 +201,10 @@ pub fn run_scene(
     classifier: &impl Classifier,
     mut view: impl FnMut(&SceneView<'_>),
 ) {
-    let sc = scenario_config(i, &cfg.world, cfg.worn);
+    let sc = ScenarioConfig {
+        power: cfg.power,
+        ..scenario_config(i, &cfg.world, cfg.worn)
+    };
     let mut scenario = Scenario::new(scenario_seed(cfg.seed, i), &sc);
     let start = scenario.robot_start_pose();
     let world_to_map = start.inverse();

@@ -73,6 +73,9 @@ pub struct DatasetConfig {
     /// Share of scenarios whose LiDAR is a worn unit (`sim::wear`: returns fading with range,
     /// mixed pixels at depth edges); 0 leaves every scenario as it was.
     pub worn: f64,
+    /// Share of scenarios whose LiDAR returns by the light it receives (`sim::power`); 0
+    /// leaves every scenario as it was.
+    pub power: f64,
 }
 
 impl Default for DatasetConfig {
@@ -92,6 +95,7 @@ impl Default for DatasetConfig {
             seam: SeamRule::Fixed,
             deskew: false,
             worn: 0.0,
+            power: 0.0,
         }
     }
 }
@@ -137,7 +141,10 @@ pub fn simulate(
     mut on_frame: impl FnMut(&Scenario, &Frame, &[OdomSample]),
     mut on_sample: impl FnMut(&Scenario, Sample<'_>),
 ) -> Scenario {
-    let sc = scenario_config(i, &cfg.world, cfg.worn);
+    let sc = ScenarioConfig {
+        power: cfg.power,
+        ..scenario_config(i, &cfg.world, cfg.worn)
+    };
     let mut scenario = Scenario::new(scenario_seed(cfg.seed, i), &sc);
     if cfg.people > 0 {
         scenario.add_people(scenario_seed(cfg.seed, i), cfg.people);

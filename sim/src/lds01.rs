@@ -8,13 +8,15 @@
 //!
 //! Dropouts (range 0): a base rate, more on dark surfaces (low reflectivity) and at glancing
 //! incidence, and most returns beyond the 3.5 m spec range are lost (a few come back, up to
-//! 4.2 m), as in real recordings (~14 % zeros, 4 % beyond 3.5 m).
+//! 4.2 m), as in real recordings (~14 % zeros, 4 % beyond 3.5 m). On request a unit returns
+//! by the light it receives instead of the dark and glancing terms (`crate::power`).
 
 use drivers::lds01::{PACKET_LEN, PACKETS_PER_REV, RawReading};
 use perception::geometry::Pose2;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
+use crate::power::ReceivedPower;
 use crate::scenario::{Frame, Scenario, ScenarioConfig};
 use crate::wear::Wear;
 use crate::world::World;
@@ -49,6 +51,9 @@ pub struct Lds01SimConfig {
     pub noise_frac: f32,
     /// A real unit's wear (fading returns, mixed pixels); none by default.
     pub wear: Wear,
+    /// Returns decided by the received power ([`ReceivedPower`]) instead of the dark and
+    /// glancing terms; `None` by default (the additive model).
+    pub power: Option<ReceivedPower>,
 }
 
 impl Default for Lds01SimConfig {
@@ -64,6 +69,7 @@ impl Default for Lds01SimConfig {
             far_max_m: 4.2,
             noise_frac: 0.025,
             wear: Wear::default(),
+            power: None,
         }
     }
 }
@@ -162,10 +168,14 @@ impl LidarModel {
     ) -> RawReading {
         let c = &self.cfg;
         let returns = if r <= c.spec_max_m {
-            let p_drop = c.dropout
-                + c.dark_dropout * f64::from(1.0 - reflectivity)
-                + c.glancing_dropout * f64::from((0.3 - cos).max(0.0) / 0.3)
-                + c.wear.fade_at(r, c.spec_max_m);
+            let p_drop = match c.power {
+                Some(power) => 1.0 - (1.0 - c.dropout) * power.return_chance(r, cos, reflectivity),
+                None => {
+                    c.dropout
+                        + c.dark_dropout * f64::from(1.0 - reflectivity)
+                        + c.glancing_dropout * f64::from((0.3 - cos).max(0.0) / 0.3)
+                }
+            } + c.wear.fade_at(r, c.spec_max_m);
             !self.rng.random_bool(p_drop.clamp(0.0, 1.0))
         } else {
             r <= c.far_max_m && self.rng.random_bool(c.far_return * f64::from(reflectivity))

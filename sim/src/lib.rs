@@ -19,6 +19,7 @@
 //! | [`noise`]     | the bounded, unit-σ noise every sensor model draws from               |
 //! | `picture`     | a PNG of a scene for people to look at (feature `tools`)              |
 //! | [`wear`]      | a real unit's wear: returns fading with range, mixed pixels at depth edges |
+//! | [`power`]     | a unit that returns by the light it receives (reflectivity · cos / range²) |
 //! | [`wire`]      | every LiDAR model's bytes from the same simulated revolutions          |
 //! | [`corrupt`]   | a noisy serial line: bit flips, inserted and dropped bytes, with truth |
 //! | `pty`         | devices on pseudo-terminals for hardware-in-the-loop tests (feature `pty`) |
@@ -34,6 +35,7 @@ pub mod noise;
 pub mod people;
 #[cfg(feature = "tools")]
 pub mod picture;
+pub mod power;
 #[cfg(feature = "pty")]
 pub mod pty;
 pub mod robot;

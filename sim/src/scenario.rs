@@ -15,6 +15,7 @@ use rand_chacha::ChaCha8Rng;
 use crate::compass::{Compass, CompassConfig};
 use crate::lds01::{LIDAR_MOUNT, Lds01SimConfig, LidarModel};
 use crate::people::{ROBOT_RADIUS_M, Walker};
+use crate::power::ReceivedPower;
 use crate::robot::{Robot, RobotConfig};
 use crate::wear::Wear;
 use crate::world::{Shape, Surface, World, WorldConfig};
@@ -36,6 +37,10 @@ pub struct ScenarioConfig {
     /// scenario's seed on a salted stream of its own; 0 (the default) leaves every scenario as
     /// it was.
     pub worn: f64,
+    /// Share of scenarios whose LiDAR returns by the light it receives
+    /// ([`crate::power::ReceivedPower::draw`]), decided from the scenario's seed on a salted
+    /// stream of its own; 0 (the default) leaves every scenario as it was.
+    pub power: f64,
 }
 
 impl ScenarioConfig {
@@ -176,6 +181,12 @@ impl Scenario {
             let mut rng = ChaCha8Rng::seed_from_u64(seed ^ WEAR_SALT);
             if rng.random_bool(cfg.worn.min(1.0)) {
                 lidar_cfg.wear = Wear::draw(rng.random());
+            }
+        }
+        if cfg.power > 0.0 {
+            let mut rng = ChaCha8Rng::seed_from_u64(seed ^ POWER_SALT);
+            if rng.random_bool(cfg.power.min(1.0)) {
+                lidar_cfg.power = Some(ReceivedPower::draw(rng.random()));
             }
         }
         let lidar = LidarModel::new(lidar_cfg, lidar_seed);
@@ -353,6 +364,10 @@ impl Scenario {
 /// Salt of the stream that decides whether a scenario's LiDAR is worn ([`ScenarioConfig::worn`]).
 const WEAR_SALT: u64 = 0x3EA2_F00D_71C5_0B9E;
 
+/// Salt of the stream that decides whether a scenario's LiDAR returns by received power
+/// ([`ScenarioConfig::power`]).
+const POWER_SALT: u64 = 0x51D7_0C3A_E29B_4F61;
+
 /// Salt of the people's own random stream ([`Scenario::add_people`]).
 const PEOPLE_SALT: u64 = 0x9E0F_1E5B_2A47_C3D8;
 
@@ -466,6 +481,38 @@ mod test {
         assert_eq!(off0, 0, "a fresh unit reads every return on its surface");
         assert!(off1 * 400 > n1, "mixed pixels: {off1} of {n1}");
         assert!(n1 < n0 && far1 < far0, "{n1} < {n0}, {far1} < {far0}");
+    }
+
+    #[test]
+    fn a_unit_that_returns_by_received_power_thins_with_range() {
+        // (returns, returns of surfaces beyond 2.5 m) over the same scenarios.
+        let tally = |power: f64| {
+            let cfg = ScenarioConfig {
+                power,
+                ..ScenarioConfig::standard()
+            };
+            let (mut returns, mut far) = (0usize, 0usize);
+            for seed in 0..4 {
+                let mut s = Scenario::new(seed, &cfg);
+                assert_eq!(s.lidar.cfg().power.is_some(), power > 0.0);
+                let (mut f, mut odom) = (Frame::default(), Vec::new());
+                for _ in 0..10 {
+                    s.next_frame(&mut f, &mut odom);
+                    for r in f.readings.iter().filter(|r| r.raw.range_mm != 0) {
+                        returns += 1;
+                        far += usize::from(r.true_range_m > 2.5);
+                    }
+                }
+            }
+            (returns, far)
+        };
+        let (n0, far0) = tally(0.0);
+        let (n1, far1) = tally(1.0);
+        // The far share falls: the received power goes with 1 / range².
+        assert!(
+            far1 * n0 < far0 * n1 && far1 < far0,
+            "{far1} of {n1} against {far0} of {n0}"
+        );
     }
 
     #[test]

@@ -97,6 +97,10 @@ enum Command {
         /// Share of scenes seen by a worn LiDAR (`umbra-sim dataset --worn`; 0: none).
         #[arg(long, default_value_t = 0.0)]
         worn: f64,
+        /// Share of scenes seen by a LiDAR that returns by received power (`umbra-sim dataset
+        /// --power`; 0: none).
+        #[arg(long, default_value_t = 0.0)]
+        power: f64,
     },
     /// Writes the detections' score calibration (`models/src/calibration_counts.rs`) from
     /// `eval-world --json` files: each file's families' detection counts by source, class and
@@ -321,12 +325,14 @@ fn run(cli: Cli) -> Result<(), String> {
             round_tables,
             box_sizes,
             worn,
+            power,
         } => {
             let mut cfg = scene_cfg(seed, pose, Worlds { clutter, varied });
             cfg.world.office_chairs = office_chairs;
             cfg.world.round_tables = round_tables;
             cfg.world.box_sizes = box_sizes;
             cfg.worn = worn;
+            cfg.power = power;
             let mut method = Box::new(MethodA::new());
             let mut text = csv_header();
             text.push('\n');

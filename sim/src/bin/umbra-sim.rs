@@ -115,6 +115,11 @@ enum Command {
         /// mixed pixels at depth edges (`sim::wear`).
         #[arg(long, default_value_t = 0.0)]
         worn: f64,
+        /// Share of scenarios whose LiDAR returns by the light it receives (0–1):
+        /// reflectivity · cos(incidence) / range² against a threshold of its own (`sim::power`),
+        /// instead of the additive dark and glancing dropouts.
+        #[arg(long, default_value_t = 0.0)]
+        power: f64,
     },
     /// Labelled frames per second, rasters and labels in memory.
     Speed {
@@ -210,6 +215,7 @@ fn run(command: Command) -> Result<(), String> {
             seam,
             deskew,
             worn,
+            power,
         } => {
             let cfg = DatasetConfig {
                 scenarios,
@@ -236,6 +242,7 @@ fn run(command: Command) -> Result<(), String> {
                 },
                 deskew,
                 worn,
+                power,
                 ..DatasetConfig::default()
             };
             let bar = ProgressBar::new((scenarios * frames) as u64);
