@@ -94,6 +94,10 @@ enum Command {
         /// --box-sizes`; 0: none).
         #[arg(long, default_value_t = 0.0)]
         box_sizes: f64,
+        /// Share of a varied world's boxes drawn dark (`umbra-sim dataset --dark-boxes`; 0:
+        /// none).
+        #[arg(long, default_value_t = 0.0)]
+        dark_boxes: f64,
         /// Share of scenes seen by a worn LiDAR (`umbra-sim dataset --worn`; 0: none).
         #[arg(long, default_value_t = 0.0)]
         worn: f64,
@@ -324,6 +328,7 @@ fn run(cli: Cli) -> Result<(), String> {
             office_chairs,
             round_tables,
             box_sizes,
+            dark_boxes,
             worn,
             power,
         } => {
@@ -331,6 +336,7 @@ fn run(cli: Cli) -> Result<(), String> {
             cfg.world.office_chairs = office_chairs;
             cfg.world.round_tables = round_tables;
             cfg.world.box_sizes = box_sizes;
+            cfg.world.dark_boxes = dark_boxes;
             cfg.worn = worn;
             cfg.power = power;
             let mut method = Box::new(MethodA::new());

@@ -82,6 +82,9 @@ enum Command {
         /// (0–1).
         #[arg(long, default_value_t = 0.0)]
         box_sizes: f64,
+        /// Share of a varied world's boxes drawn dark, reflectivity 0.05–0.5 (0–1).
+        #[arg(long, default_value_t = 0.0)]
+        dark_boxes: f64,
         /// Skip Method B images and labels.
         #[arg(long)]
         no_images: bool,
@@ -206,6 +209,7 @@ fn run(command: Command) -> Result<(), String> {
             office_chairs,
             round_tables,
             box_sizes,
+            dark_boxes,
             no_images,
             no_method_a,
             no_recordings,
@@ -228,6 +232,7 @@ fn run(command: Command) -> Result<(), String> {
                     office_chairs,
                     round_tables,
                     box_sizes,
+                    dark_boxes,
                     ..WorldConfig::default()
                 },
                 method_b: !no_images,

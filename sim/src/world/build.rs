@@ -51,6 +51,8 @@ pub(super) struct Builder {
     pub(super) round_share: f64,
     /// Share of boxes drawn with sides of their own (0 unless asked for in a varied world).
     pub(super) box_share: f64,
+    /// Share of boxes drawn dark (0 unless asked for in a varied world).
+    pub(super) dark_box_share: f64,
     /// A second stream for the furniture styles of a varied world (`variety.rs`: office
     /// chairs, round tables, box sizes), drawn from only when they are asked for.
     pub(super) style: ChaCha8Rng,
@@ -347,7 +349,12 @@ impl Builder {
                 }
             }
             Build::Solid => {
-                let refl = self.rng.random_range(0.55..0.9);
+                let mut refl = self.rng.random_range(0.55..0.9);
+                if self.dark_box_share > 0.0 && self.style.random_bool(self.dark_box_share) {
+                    refl = self
+                        .style
+                        .random_range(super::variety::DARK_BOX_REFLECTIVITY);
+                }
                 self.polygon(&footprint, id, refl);
             }
         }

@@ -238,6 +238,10 @@ pub struct WorldConfig {
     /// long and 0.25–0.6 m deep, square ones too) instead of the study's 3 : 2 box. 0 (the
     /// default) draws none and leaves every world as it was.
     pub box_sizes: f64,
+    /// Share of a varied world's boxes drawn dark ([`variety::DARK_BOX_REFLECTIVITY`]: black
+    /// and brown plastic crates, dark cardboard) instead of 0.55–0.9. 0 (the default) draws
+    /// none and leaves every world as it was.
+    pub dark_boxes: f64,
 }
 
 impl Default for WorldConfig {
@@ -251,6 +255,7 @@ impl Default for WorldConfig {
             office_chairs: 0.0,
             round_tables: 0.0,
             box_sizes: 0.0,
+            dark_boxes: 0.0,
         }
     }
 }
@@ -311,6 +316,11 @@ impl World {
             },
             box_share: if varied {
                 cfg.box_sizes.clamp(0.0, 1.0)
+            } else {
+                0.0
+            },
+            dark_box_share: if varied {
+                cfg.dark_boxes.clamp(0.0, 1.0)
             } else {
                 0.0
             },

@@ -19,7 +19,8 @@
 //!   edge. A pedestal table would show its column alone at LiDAR height, a post like any
 //!   other (the office chair's lesson): not drawn. From the `style` stream too;
 //! * boxes of other sizes on request ([`super::WorldConfig::box_sizes`] of the boxes; none by
-//!   default): sides of their own, square ones too ([`box_half`]). From the `style` stream.
+//!   default): sides of their own, square ones too ([`box_half`]); and dark boxes
+//!   ([`super::WorldConfig::dark_boxes`], [`DARK_BOX_REFLECTIVITY`]). From the `style` stream.
 //!
 //! Wall thickness (0.05–0.25 m) and reflectivity (0.12–1.0) are drawn in `build.rs`; the
 //! LiDAR's reach and dropouts in `Lds01SimConfig::varied`. Everything here draws from the
@@ -57,6 +58,10 @@ pub(super) fn box_half(long_u: f32, deep_u: f32) -> (f32, f32) {
     let deep = 0.25 + (deep_max - 0.25) * deep_u.clamp(0.0, 1.0);
     (long / 2.0, deep / 2.0)
 }
+
+/// Reflectivity of a dark box ([`super::WorldConfig::dark_boxes`]): black plastic crates
+/// reflect a few per cent of the light, brown cardboard about a third to a half.
+pub(super) const DARK_BOX_REFLECTIVITY: core::ops::Range<f32> = 0.05..0.5;
 
 /// The top's radius of a round table drawn at `scale` (0.8–1.2): 0.35–0.55 m.
 pub(super) fn round_top_radius(scale: f32) -> f32 {
@@ -694,5 +699,45 @@ mod test {
         // Never deeper than long.
         let (l, d) = box_half(0.0, 1.0);
         assert!((l - d).abs() < 1e-6);
+    }
+
+    #[test]
+    fn dark_boxes_are_drawn_dark_in_varied_worlds_when_asked() {
+        let dark = WorldConfig {
+            dark_boxes: 0.5,
+            ..varied()
+        };
+        let (mut boxes, mut darker) = (0, 0);
+        for seed in 0..80 {
+            let w = World::generate(seed, &dark);
+            let plain = World::generate(seed, &varied());
+            // The same world but for the boxes' reflectivity.
+            assert_eq!(w.prims.len(), plain.prims.len());
+            for (p, q) in w.prims.iter().zip(&plain.prims) {
+                assert_eq!((p.shape, p.surface), (q.shape, q.surface));
+                let is_box = matches!(p.surface, Surface::Object(k)
+                    if w.objects[usize::from(k)].class == ObjectClass::Box);
+                if !is_box {
+                    assert_eq!(p.reflectivity, q.reflectivity);
+                } else if p.reflectivity != q.reflectivity {
+                    assert!(DARK_BOX_REFLECTIVITY.contains(&p.reflectivity));
+                    darker += 1;
+                }
+                boxes += usize::from(is_box);
+            }
+            let study = WorldConfig {
+                dark_boxes: 0.5,
+                ..WorldConfig::default()
+            };
+            assert_eq!(
+                World::generate(seed, &study).prims,
+                World::generate(seed, &WorldConfig::default()).prims
+            );
+        }
+        // Half the boxes' faces (each box is four segments).
+        assert!(
+            darker * 4 >= boxes && darker * 4 <= boxes * 3,
+            "{darker} of {boxes}"
+        );
     }
 }
