@@ -26,6 +26,9 @@
 //! Regenerating the committed forest is the two commands `forest-data` and `forest-train` with
 //! their defaults; both are deterministic.
 
+#[path = "umbra-lab/variety.rs"]
+mod variety;
+
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -82,29 +85,8 @@ enum Command {
         /// learns wall pieces of other thickness, reach and dropout, shelves and pillars.
         #[arg(long, default_value_t = 0.5)]
         varied: f64,
-        /// Share of a varied world's chairs drawn as office chairs (`umbra-sim dataset
-        /// --office-chairs`; 0: none, `docs/world.md` says why).
-        #[arg(long, default_value_t = 0.0)]
-        office_chairs: f64,
-        /// Share of a varied world's desks drawn as round tables (`umbra-sim dataset
-        /// --round-tables`; 0: none).
-        #[arg(long, default_value_t = 0.0)]
-        round_tables: f64,
-        /// Share of a varied world's boxes drawn with sides of their own (`umbra-sim dataset
-        /// --box-sizes`; 0: none).
-        #[arg(long, default_value_t = 0.0)]
-        box_sizes: f64,
-        /// Share of a varied world's boxes drawn dark (`umbra-sim dataset --dark-boxes`; 0:
-        /// none).
-        #[arg(long, default_value_t = 0.0)]
-        dark_boxes: f64,
-        /// Share of scenes seen by a worn LiDAR (`umbra-sim dataset --worn`; 0: none).
-        #[arg(long, default_value_t = 0.0)]
-        worn: f64,
-        /// Share of scenes seen by a LiDAR that returns by received power (`umbra-sim dataset
-        /// --power`; 0: none).
-        #[arg(long, default_value_t = 0.0)]
-        power: f64,
+        #[command(flatten)]
+        variety: variety::Variety,
     },
     /// Writes the detections' score calibration (`models/src/calibration_counts.rs`) from
     /// `eval-world --json` files: each file's families' detection counts by source, class and
@@ -325,20 +307,10 @@ fn run(cli: Cli) -> Result<(), String> {
             pose,
             clutter,
             varied,
-            office_chairs,
-            round_tables,
-            box_sizes,
-            dark_boxes,
-            worn,
-            power,
+            variety,
         } => {
             let mut cfg = scene_cfg(seed, pose, Worlds { clutter, varied });
-            cfg.world.office_chairs = office_chairs;
-            cfg.world.round_tables = round_tables;
-            cfg.world.box_sizes = box_sizes;
-            cfg.world.dark_boxes = dark_boxes;
-            cfg.worn = worn;
-            cfg.power = power;
+            variety.apply(&mut cfg);
             let mut method = Box::new(MethodA::new());
             let mut text = csv_header();
             text.push('\n');
