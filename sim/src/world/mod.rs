@@ -218,6 +218,8 @@ impl World {
         } else {
             WALL_T
         };
+        // A style's share applies in a varied world only.
+        let share = |p: f64| if varied { p.clamp(0.0, 1.0) } else { 0.0 };
         let mut b = Builder {
             rng,
             prims: Vec::new(),
@@ -228,26 +230,10 @@ impl World {
             keep_out: Vec::new(),
             wall_t,
             varied,
-            office_share: if varied {
-                cfg.office_chairs.clamp(0.0, 1.0)
-            } else {
-                0.0
-            },
-            round_share: if varied {
-                cfg.round_tables.clamp(0.0, 1.0)
-            } else {
-                0.0
-            },
-            box_share: if varied {
-                cfg.box_sizes.clamp(0.0, 1.0)
-            } else {
-                0.0
-            },
-            dark_box_share: if varied {
-                cfg.dark_boxes.clamp(0.0, 1.0)
-            } else {
-                0.0
-            },
+            office_share: share(cfg.office_chairs),
+            round_share: share(cfg.round_tables),
+            box_share: share(cfg.box_sizes),
+            dark_box_share: share(cfg.dark_boxes),
             style: ChaCha8Rng::seed_from_u64(seed ^ 0x000f_f1ce),
         };
         let door_min = if varied {
