@@ -85,6 +85,10 @@ enum Command {
         /// Share of a varied world's boxes drawn dark, reflectivity 0.05–0.5 (0–1).
         #[arg(long, default_value_t = 0.0)]
         dark_boxes: f64,
+        /// Share of office chairs whose base's arms lie in the scan plane, each seen whole
+        /// (a LiDAR at the hub's height) (0–1).
+        #[arg(long, default_value_t = 0.0)]
+        office_spokes: f64,
         /// Skip Method B images and labels.
         #[arg(long)]
         no_images: bool,
@@ -210,6 +214,7 @@ fn run(command: Command) -> Result<(), String> {
             round_tables,
             box_sizes,
             dark_boxes,
+            office_spokes,
             no_images,
             no_method_a,
             no_recordings,
@@ -233,6 +238,7 @@ fn run(command: Command) -> Result<(), String> {
                     round_tables,
                     box_sizes,
                     dark_boxes,
+                    office_spokes,
                     ..WorldConfig::default()
                 },
                 method_b: !no_images,

@@ -53,6 +53,8 @@ pub(super) struct Builder {
     pub(super) box_share: f64,
     /// Share of boxes drawn dark (0 unless asked for in a varied world).
     pub(super) dark_box_share: f64,
+    /// Share of office chairs whose arms lie in the scan plane (0 unless asked for).
+    pub(super) spoke_share: f64,
     /// A second stream for the furniture styles of a varied world (`variety.rs`: office
     /// chairs, round tables, box sizes), drawn from only when they are asked for.
     pub(super) style: ChaCha8Rng,

@@ -62,6 +62,11 @@ pub struct WorldConfig {
     /// and brown plastic crates, dark cardboard) instead of 0.55–0.9. 0 (the default) draws
     /// none and leaves every world as it was.
     pub dark_boxes: f64,
+    /// Share of office chairs whose base's five arms lie in the scan plane, each seen whole from
+    /// the hub to its caster (`variety.rs`: a LiDAR mounted at the hub's height, 0.1–0.15 m, as
+    /// on robots lower than a TurtleBot3 Burger), instead of cut at one radius where they
+    /// climb through it. 0 (the default) draws none and leaves every world as it was.
+    pub office_spokes: f64,
 }
 
 impl Default for WorldConfig {
@@ -76,6 +81,7 @@ impl Default for WorldConfig {
             round_tables: 0.0,
             box_sizes: 0.0,
             dark_boxes: 0.0,
+            office_spokes: 0.0,
         }
     }
 }

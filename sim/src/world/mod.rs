@@ -234,6 +234,7 @@ impl World {
             round_share: share(cfg.round_tables),
             box_share: share(cfg.box_sizes),
             dark_box_share: share(cfg.dark_boxes),
+            spoke_share: share(cfg.office_spokes),
             style: ChaCha8Rng::seed_from_u64(seed ^ 0x000f_f1ce),
         };
         let door_min = if varied {

@@ -12,8 +12,10 @@
 //! * office chairs on request ([`super::WorldConfig::office_chairs`] of the chairs; none by
 //!   default) on a five-star base 0.5–0.7 m across:
 //!   at LiDAR height a scan cuts the gas column (5–8 cm) and the base's five arms at one
-//!   radius, where they rise through the scan plane from the casters to the hub. Drawn from
-//!   the world's own `style` stream;
+//!   radius, where they rise through the scan plane from the casters to the hub; on request
+//!   ([`super::WorldConfig::office_spokes`]) a share of them with the arms in the scan plane,
+//!   each seen whole, as a LiDAR at the hub's height sees them. Drawn from the world's own
+//!   `style` stream;
 //! * round tables on request ([`super::WorldConfig::round_tables`] of the desks; none by
 //!   default), 0.7–1.1 m across on three or four legs (2–5 cm) set 5–12 cm in from the top's
 //!   edge. A pedestal table would show its column alone at LiDAR height, a post like any
@@ -196,10 +198,32 @@ impl Builder {
     /// plane would show the column alone, a post nothing tells from any other: not drawn,
     /// because a forest trained on such chairs took posts and people's legs for chairs
     /// (`docs/world.md`, 18th session).
+    ///
+    /// A share of them ([`super::WorldConfig::office_spokes`]) lie in the scan plane instead:
+    /// five flat arms 4–6 cm wide from the hub to 0–4 cm short of the base's radius, each seen
+    /// whole.
     pub(super) fn office_chair(&mut self, c: Point2, yaw: f32, radius: f32, id: Surface) {
         let column = self.style.random_range(0.025..0.04f32);
         let refl = self.style.random_range(0.3..0.9f32);
         self.circle(c, column, id, refl);
+        if self.spoke_share > 0.0 && self.style.random_bool(self.spoke_share) {
+            let half_w = self.style.random_range(0.02..0.03f32);
+            let reach = radius - self.style.random_range(0.0..0.04f32);
+            let refl = self.style.random_range(0.15..0.9f32);
+            for k in 0..5 {
+                let a = yaw + k as f32 * (2.0 * PI / 5.0);
+                let (s, co) = a.sin_cos();
+                let at = |r: f32, w: f32| Point2::new(c.x + r * co - w * s, c.y + r * s + w * co);
+                let arm = [
+                    at(column, -half_w),
+                    at(reach, -half_w),
+                    at(reach, half_w),
+                    at(column, half_w),
+                ];
+                self.polygon(&arm, id, refl);
+            }
+            return;
+        }
         let cut = self.style.random_range(0.1..radius - 0.04);
         let arm = self.style.random_range(0.018..0.028f32);
         let refl = self.style.random_range(0.15..0.9f32);
@@ -594,6 +618,65 @@ mod test {
         assert!(
             office_chairs * 5 >= chairs && office_chairs * 5 <= chairs * 3,
             "{office_chairs} office chairs of {chairs}"
+        );
+    }
+
+    #[test]
+    fn office_chairs_arms_lie_in_the_scan_plane_when_asked() {
+        let spokes = WorldConfig {
+            office_chairs: 1.0,
+            office_spokes: 0.5,
+            ..varied()
+        };
+        let (mut chairs, mut flat) = (0, 0);
+        for seed in 0..60 {
+            let w = World::generate(seed, &spokes);
+            for (i, o) in w.objects.iter().enumerate() {
+                if o.class != ObjectClass::Chair {
+                    continue;
+                }
+                chairs += 1;
+                let segs: Vec<_> = w
+                    .prims
+                    .iter()
+                    .filter(|p| p.surface == Surface::Object(i as u16))
+                    .filter_map(|p| match p.shape {
+                        Shape::Segment { a, b } => Some((a, b)),
+                        Shape::Circle { .. } => None,
+                    })
+                    .collect();
+                match (circles(&w, i).len(), segs.len()) {
+                    (6, 0) => {}
+                    (1, 20) => {
+                        // Five arms 4–6 cm wide from the column out to the base's radius.
+                        let half = o.footprint[0].distance(o.footprint[1]) / 2.0;
+                        let far = segs
+                            .iter()
+                            .map(|&(a, _)| a.distance(o.centre))
+                            .fold(0.0f32, f32::max);
+                        assert!(far <= half + 0.031 && far >= half - 0.05, "{far} of {half}");
+                        for arm in segs.chunks(4) {
+                            let width = arm[1].0.distance(arm[1].1);
+                            assert!((0.039..0.061).contains(&width), "arm {width} m wide");
+                        }
+                        flat += 1;
+                    }
+                    parts => panic!("seed {seed} piece {i}: {parts:?}"),
+                }
+            }
+            // Without office chairs nothing changes.
+            let none = WorldConfig {
+                office_spokes: 0.5,
+                ..varied()
+            };
+            assert_eq!(
+                World::generate(seed, &none).prims,
+                World::generate(seed, &varied()).prims
+            );
+        }
+        assert!(
+            flat * 4 >= chairs && flat * 4 <= chairs * 3,
+            "{flat} of {chairs}"
         );
     }
 

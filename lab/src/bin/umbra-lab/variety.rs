@@ -19,6 +19,9 @@ pub struct Variety {
     /// Share of a varied world's boxes drawn dark.
     #[arg(long, default_value_t = 0.0)]
     pub dark_boxes: f64,
+    /// Share of office chairs whose base's arms lie in the scan plane.
+    #[arg(long, default_value_t = 0.0)]
+    pub office_spokes: f64,
     /// Share of scenes seen by a worn LiDAR.
     #[arg(long, default_value_t = 0.0)]
     pub worn: f64,
@@ -34,6 +37,7 @@ impl Variety {
         cfg.world.round_tables = self.round_tables;
         cfg.world.box_sizes = self.box_sizes;
         cfg.world.dark_boxes = self.dark_boxes;
+        cfg.world.office_spokes = self.office_spokes;
         cfg.worn = self.worn;
         cfg.power = self.power;
     }
