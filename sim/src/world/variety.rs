@@ -207,23 +207,14 @@ impl Builder {
         let refl = self.style.random_range(0.3..0.9f32);
         self.circle(c, column, id, refl);
         if self.spoke_share > 0.0 && self.style.random_bool(self.spoke_share) {
-            let half_w = self.style.random_range(0.02..0.03f32);
-            let reach = radius - self.style.random_range(0.0..0.04f32);
-            let refl = self.style.random_range(0.15..0.9f32);
-            for k in 0..5 {
-                let a = yaw + k as f32 * (2.0 * PI / 5.0);
-                let (s, co) = a.sin_cos();
-                let at = |r: f32, w: f32| Point2::new(c.x + r * co - w * s, c.y + r * s + w * co);
-                let arm = [
-                    at(column, -half_w),
-                    at(reach, -half_w),
-                    at(reach, half_w),
-                    at(column, half_w),
-                ];
-                self.polygon(&arm, id, refl);
-            }
-            return;
+            self.flat_arms(c, yaw, radius, column, id);
+        } else {
+            self.cut_arms(c, yaw, radius, id);
         }
+    }
+
+    /// The five arms of an office chair's base where the scan plane cuts them, at one radius.
+    fn cut_arms(&mut self, c: Point2, yaw: f32, radius: f32, id: Surface) {
         let cut = self.style.random_range(0.1..radius - 0.04);
         let arm = self.style.random_range(0.018..0.028f32);
         let refl = self.style.random_range(0.15..0.9f32);
@@ -231,6 +222,26 @@ impl Builder {
             let a = yaw + k as f32 * (2.0 * PI / 5.0);
             let p = Point2::new(c.x + cut * a.cos(), c.y + cut * a.sin());
             self.circle(p, arm, id, refl);
+        }
+    }
+
+    /// The five arms of an office chair's base lying in the scan plane, each seen whole: 4–6
+    /// cm wide, from the column (`column` m) to 0–4 cm short of the base's `radius`.
+    fn flat_arms(&mut self, c: Point2, yaw: f32, radius: f32, column: f32, id: Surface) {
+        let half_w = self.style.random_range(0.02..0.03f32);
+        let reach = radius - self.style.random_range(0.0..0.04f32);
+        let refl = self.style.random_range(0.15..0.9f32);
+        for k in 0..5 {
+            let a = yaw + k as f32 * (2.0 * PI / 5.0);
+            let (s, co) = a.sin_cos();
+            let at = |r: f32, w: f32| Point2::new(c.x + r * co - w * s, c.y + r * s + w * co);
+            let arm = [
+                at(column, -half_w),
+                at(reach, -half_w),
+                at(reach, half_w),
+                at(column, half_w),
+            ];
+            self.polygon(&arm, id, refl);
         }
     }
 
