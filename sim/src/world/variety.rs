@@ -565,6 +565,18 @@ mod test {
             .collect()
     }
 
+    /// The straight sides of piece `i` of `w`, as (a, b) pairs.
+    fn segments(w: &World, i: usize) -> Vec<(Point2, Point2)> {
+        w.prims
+            .iter()
+            .filter(|p| p.surface == Surface::Object(i as u16))
+            .filter_map(|p| match p.shape {
+                Shape::Segment { a, b } => Some((a, b)),
+                Shape::Circle { .. } => None,
+            })
+            .collect()
+    }
+
     #[test]
     fn office_chairs_stand_on_five_arms_in_varied_worlds_when_asked() {
         let office = WorldConfig {
@@ -647,15 +659,7 @@ mod test {
                     continue;
                 }
                 chairs += 1;
-                let segs: Vec<_> = w
-                    .prims
-                    .iter()
-                    .filter(|p| p.surface == Surface::Object(i as u16))
-                    .filter_map(|p| match p.shape {
-                        Shape::Segment { a, b } => Some((a, b)),
-                        Shape::Circle { .. } => None,
-                    })
-                    .collect();
+                let segs = segments(&w, i);
                 match (circles(&w, i).len(), segs.len()) {
                     (6, 0) => {}
                     (1, 20) => {
