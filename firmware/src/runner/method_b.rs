@@ -77,8 +77,8 @@ impl Schedule {
 /// Which compiled-in file Method B runs (`[method_b] precision`); a `--model` or `[method_b]
 /// model` file is run whatever this says. fp32 by default on every board: int8 counts fewer
 /// instructions only on a Pi 3 with a 64-bit OS (147 against 159 M a frame; a Pi 5 +4 %, a
-/// Pi 3 on a 32-bit OS +52 %, `docs/pi-budget.md`), and through the world model it finds less
-/// (`docs/world.md`, 49th session).
+/// Pi 3 on a 32-bit OS +52 %, `docs/pi-budget.md`), and through the world model it scores worse
+/// (`docs/world.md`, 49th and 54th sessions).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum Precision {
