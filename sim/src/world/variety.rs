@@ -553,12 +553,18 @@ mod test {
         assert!(tucked >= 20, "{tucked} chairs at desks in {pieces} pieces");
     }
 
-    /// The round things a piece is built of.
-    fn circles(w: &World, i: usize) -> Vec<(Point2, f32)> {
+    /// The primitives piece `i` of `w` is built of.
+    fn shapes(w: &World, i: usize) -> impl Iterator<Item = Shape> + '_ {
         w.prims
             .iter()
-            .filter(|p| p.surface == Surface::Object(i as u16))
-            .filter_map(|p| match p.shape {
+            .filter(move |p| p.surface == Surface::Object(i as u16))
+            .map(|p| p.shape)
+    }
+
+    /// The round things a piece is built of.
+    fn circles(w: &World, i: usize) -> Vec<(Point2, f32)> {
+        shapes(w, i)
+            .filter_map(|s| match s {
                 Shape::Circle { c, r } => Some((c, r)),
                 Shape::Segment { .. } => None,
             })
@@ -567,10 +573,8 @@ mod test {
 
     /// The straight sides of piece `i` of `w`, as (a, b) pairs.
     fn segments(w: &World, i: usize) -> Vec<(Point2, Point2)> {
-        w.prims
-            .iter()
-            .filter(|p| p.surface == Surface::Object(i as u16))
-            .filter_map(|p| match p.shape {
+        shapes(w, i)
+            .filter_map(|s| match s {
                 Shape::Segment { a, b } => Some((a, b)),
                 Shape::Circle { .. } => None,
             })
